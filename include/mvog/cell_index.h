@@ -1,0 +1,35 @@
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+namespace mvog {
+
+/// Cell (i, j) of the grid: i <= s * x < i + 1 and j <= s * y < j + 1 (Sec. III-A).
+struct CellIndex {
+  std::int32_t x = 0;
+  std::int32_t y = 0;
+
+  friend bool operator==(const CellIndex& a, const CellIndex& b) { return a.x == b.x && a.y == b.y; }
+  friend bool operator!=(const CellIndex& a, const CellIndex& b) { return !(a == b); }
+};
+
+/// The cell that grid coordinate (gx, gy) = s * (x, y) projects onto.
+inline CellIndex cellAt(double gx, double gy) {
+  return {static_cast<std::int32_t>(std::floor(gx)), static_cast<std::int32_t>(std::floor(gy))};
+}
+
+/// An inclusive rectangle of cells.
+struct CellRange {
+  CellIndex min;
+  CellIndex max;
+
+  bool empty() const { return max.x < min.x || max.y < min.y; }
+  std::int64_t width() const { return empty() ? 0 : std::int64_t{max.x} - min.x + 1; }
+  std::int64_t height() const { return empty() ? 0 : std::int64_t{max.y} - min.y + 1; }
+  bool contains(const CellIndex& c) const {
+    return c.x >= min.x && c.x <= max.x && c.y >= min.y && c.y <= max.y;
+  }
+};
+
+}  // namespace mvog

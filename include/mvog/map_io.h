@@ -1,0 +1,50 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mvog/map.h"
+
+namespace mvog {
+
+/// A map file or buffer that cannot be read or written; the message says what is wrong.
+class MapFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The binary map format, version 1. Everything little-endian, no padding:
+///
+///   offset  size  field
+///        0     8  magic "MVOGMAP\0"
+///        8     4  uint32 format version (1)
+///       12     4  uint32 header size in bytes (64)
+///       16     8  float64 resolution (m)
+///       24     8  float64 max_coordinate (m)
+///       32     8  uint64 number of cells C (cells holding at least one volume)
+///       40     8  uint64 number of volumes V (positive and negative)
+///       48    16  reserved, zero
+///       64     .  C cells, each: int32 x, int32 y, uint32 n_positive, uint32 n_negative,
+///                 then n_positive + n_negative volumes (float32 bottom, top, mass; heights in
+///                 grid units, positive list first, each list sorted upwards)
+///   end - 8    8  uint64 FNV-1a 64 checksum of every byte before it
+///
+/// The file size must equal 64 + 16 C + 12 V + 8, which bounds every count before anything is
+/// allocated. Masses are the masses as of saving (decay folded in).
+constexpr std::uint32_t kMapFormatVersion = 1;
+constexpr std::size_t kMapHeaderBytes = 64;
+
+std::vector<std::uint8_t> serializeMap(const Map& map);
+/// Throws MapFileError if `data` is not a complete, valid map (nothing is half-loaded).
+Map deserializeMap(const std::uint8_t* data, std::size_t size);
+
+/// Writes atomically: a temporary file in the same directory, fsync, then rename over `path`.
+/// Throws MapFileError on failure (and leaves any previous file at `path` untouched).
+void saveMap(const Map& map, const std::string& path);
+/// Throws MapFileError if the file cannot be read or is not a valid map.
+Map loadMap(const std::string& path);
+
+}  // namespace mvog

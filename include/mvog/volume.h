@@ -1,0 +1,51 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace mvog {
+
+/// One vertical volume of a cell's column (paper Sec. III-A): heights in grid units (z * s, where
+/// s = 1 / resolution) and an occupancy mass. A cell's area is 1 in grid units, so eq. (2) reads
+/// density = mass / height, and a new volume of density 1 has a mass equal to its height.
+struct Volume {
+  float bottom = 0.0f;
+  float top = 0.0f;
+  float mass = 0.0f;
+
+  float height() const { return top - bottom; }
+  /// Eq. (2).
+  float density() const { return mass / height(); }
+  bool contains(float z) const { return bottom <= z && z <= top; }
+};
+static_assert(sizeof(Volume) == 12, "the Table I accounting assumes 12-byte volumes");
+
+/// Which of a cell's two lists a volume belongs to.
+enum class VolumeSign : std::uint8_t { kPositive, kNegative };
+
+/// The constraints of Sec. III-A: minimum height, and the gap under which two volumes merge.
+constexpr float kMinVolumeHeight = 1.0f;
+constexpr float kMaxMergeGap = 1.0f;
+
+/// Eq. (6): the volume spanning [z_a, z_b] (either order) with the minimum height enforced around
+/// its centre. The mass is that of density 1 over the final height, times `unit_mass` (the map's
+/// stored-mass unit, see Map::decay): every new volume starts at density 1 (Sec. III-B.2).
+Volume makeVolume(float z_a, float z_b, float unit_mass);
+
+/// Inserts `volume` into the sorted list `list[0, count)` (which satisfies the Sec. III-A
+/// constraints) and restores the constraints: volumes that overlap it (eq. 7) or lie within a gap
+/// of at most 1 (eq. 8) are merged into one with the summed mass plus, for every gap filled, the
+/// gap's mass at density 1 (times `unit_mass`). `list` must have room for count + 1 volumes.
+/// Returns the new count.
+std::uint32_t insertVolume(Volume* list, std::uint32_t count, const Volume& volume,
+                           float unit_mass);
+
+/// The volume of `list[0, count)` that contains height z, or nullptr.
+const Volume* findVolume(const Volume* list, std::uint32_t count, float z);
+
+/// Empty if `list[0, count)` satisfies Sec. III-A (sorted, heights >= 1, gaps > 1, finite
+/// non-negative masses), else what is wrong with it.
+std::string checkVolumeList(const Volume* list, std::size_t count);
+
+}  // namespace mvog

@@ -1,0 +1,33 @@
+#include "mvog/config.h"
+
+#include <cmath>
+
+namespace mvog {
+namespace {
+
+void require(bool condition, const char* field, const char* reason) {
+  if (!condition) throw ConfigError(std::string(field) + ": " + reason);
+}
+
+}  // namespace
+
+void MapConfig::validate() const {
+  require(std::isfinite(resolution) && resolution > 0.0, "resolution",
+          "must be a finite number > 0");
+  require(std::isfinite(max_coordinate) && max_coordinate > 0.0, "max_coordinate",
+          "must be a finite number > 0");
+  // Heights are floats in grid units: keep them below 2^22 so that they resolve a quarter cell.
+  require(max_coordinate / resolution <= 4194304.0, "max_coordinate",
+          "must be at most 4194304 cells (max_coordinate / resolution)");
+}
+
+void InsertionConfig::validate() const {
+  require(std::isfinite(min_range) && min_range >= 0.0, "min_range",
+          "must be a finite number >= 0");
+  require(!std::isnan(max_range) && max_range > 0.0, "max_range",
+          "must be > 0 (infinity for no limit)");
+  require(min_range < max_range, "min_range", "must be smaller than max_range");
+  require(num_threads >= 1 && num_threads <= 256, "num_threads", "must be in [1, 256]");
+}
+
+}  // namespace mvog

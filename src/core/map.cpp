@@ -1,0 +1,723 @@
+#include "mvog/map.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <thread>
+#include <utility>
+
+#include "mvog/raster.h"
+
+namespace mvog {
+namespace {
+
+std::uint64_t packKey(std::int32_t x, std::int32_t y) {
+  return (std::uint64_t{static_cast<std::uint32_t>(x)} << 32) | static_cast<std::uint32_t>(y);
+}
+
+/// Readings are cut into chunks so that the buffered volumes of the threaded path stay small.
+constexpr std::size_t kReadingsPerChunk = 8192;
+
+}  // namespace
+
+// ---- Cell: one heap block [header | positive volumes | negative volumes] behind one pointer.
+// An unobserved cell costs 8 bytes; the paper's two lists share the block (Sec. III-A).
+
+class Map::Cell {
+ public:
+  Cell() = default;
+  ~Cell() { std::free(block_); }
+  Cell(const Cell&) = delete;
+  Cell& operator=(const Cell&) = delete;
+
+  std::uint32_t count(VolumeSign sign) const {
+    if (block_ == nullptr) return 0;
+    return sign == VolumeSign::kPositive ? block_->num_positive : block_->num_negative;
+  }
+  const Volume* list(VolumeSign sign) const {
+    if (block_ == nullptr) return nullptr;
+    return sign == VolumeSign::kPositive ? volumes() : volumes() + block_->num_positive;
+  }
+  bool empty() const { return block_ == nullptr; }
+  std::size_t bytes() const { return block_ == nullptr ? 0 : blockBytes(block_->capacity); }
+
+  /// Inserts with the constraints applied; returns the change of bytes held.
+  std::ptrdiff_t insert(VolumeSign sign, const Volume& volume, float unit_mass) {
+    const std::size_t old_bytes = bytes();
+    const std::uint32_t total = block_ == nullptr ? 0 : block_->num_positive + block_->num_negative;
+    reserve(total + 1);
+    Volume* all = volumes();
+    std::uint32_t& num_positive = block_->num_positive;
+    std::uint32_t& num_negative = block_->num_negative;
+    if (sign == VolumeSign::kNegative) {
+      num_negative = insertVolume(all + num_positive, num_negative, volume, unit_mass);
+    } else {
+      // Open a slot after the positive list, insert, and close what the merge left unused.
+      std::memmove(all + num_positive + 1, all + num_positive, num_negative * sizeof(Volume));
+      const std::uint32_t count = insertVolume(all, num_positive, volume, unit_mass);
+      if (count != num_positive + 1) {
+        std::memmove(all + count, all + num_positive + 1, num_negative * sizeof(Volume));
+      }
+      num_positive = count;
+    }
+    return static_cast<std::ptrdiff_t>(bytes()) - static_cast<std::ptrdiff_t>(old_bytes);
+  }
+
+  /// Replaces both lists; returns the change of bytes held.
+  std::ptrdiff_t assign(const CellVolumes& volumes_in) {
+    const std::size_t old_bytes = bytes();
+    const std::size_t total = volumes_in.positive.size() + volumes_in.negative.size();
+    std::free(block_);
+    block_ = nullptr;
+    if (total > 0) {
+      reserve(static_cast<std::uint32_t>(total));
+      block_->num_positive = static_cast<std::uint32_t>(volumes_in.positive.size());
+      block_->num_negative = static_cast<std::uint32_t>(volumes_in.negative.size());
+      std::copy(volumes_in.positive.begin(), volumes_in.positive.end(), volumes());
+      std::copy(volumes_in.negative.begin(), volumes_in.negative.end(),
+                volumes() + block_->num_positive);
+    }
+    return static_cast<std::ptrdiff_t>(bytes()) - static_cast<std::ptrdiff_t>(old_bytes);
+  }
+
+  void scaleMasses(int power_of_two) {
+    if (block_ == nullptr) return;
+    Volume* all = volumes();
+    for (std::uint32_t k = 0; k < block_->num_positive + block_->num_negative; ++k) {
+      all[k].mass = std::ldexp(all[k].mass, power_of_two);
+    }
+  }
+
+ private:
+  struct Header {
+    std::uint32_t num_positive;
+    std::uint32_t num_negative;
+    std::uint32_t capacity;
+  };
+  static_assert(alignof(Header) >= alignof(Volume) && sizeof(Header) % alignof(Volume) == 0,
+                "volumes follow the header directly");
+
+  static std::size_t blockBytes(std::uint32_t capacity) {
+    return sizeof(Header) + std::size_t{capacity} * sizeof(Volume);
+  }
+  Volume* volumes() const { return reinterpret_cast<Volume*>(block_ + 1); }
+
+  void reserve(std::uint32_t needed) {
+    const std::uint32_t capacity = block_ == nullptr ? 0 : block_->capacity;
+    if (needed <= capacity) return;
+    // Most columns hold a handful of volumes: grow by two, then by half, to keep slack small.
+    const std::uint32_t grown = std::max(needed, capacity < 4 ? capacity + 2 : capacity + capacity / 2);
+    void* block = std::realloc(block_, blockBytes(grown));
+    if (block == nullptr) throw std::bad_alloc();
+    if (block_ == nullptr) static_cast<Header*>(block)->num_positive = 0;
+    if (block_ == nullptr) static_cast<Header*>(block)->num_negative = 0;
+    block_ = static_cast<Header*>(block);
+    block_->capacity = grown;
+  }
+
+  Header* block_ = nullptr;
+};
+
+struct Map::Tile {
+  std::array<Cell, kTileSize * kTileSize> cells;
+  std::uint64_t modified_revision = 0;
+
+  Cell& at(const CellIndex& c) { return cells[localIndex(c)]; }
+  const Cell& at(const CellIndex& c) const { return cells[localIndex(c)]; }
+  static std::size_t localIndex(const CellIndex& c) {
+    constexpr std::int32_t kMask = kTileSize - 1;
+    return static_cast<std::size_t>((c.y & kMask) * kTileSize + (c.x & kMask));
+  }
+};
+
+// ---- InsertionResult / PointOccupancy --------------------------------------------------------
+
+InsertionResult& InsertionResult::operator+=(const InsertionResult& other) {
+  obstacle_readings += other.obstacle_readings;
+  out_of_range_readings += other.out_of_range_readings;
+  truncated_to_max_range += other.truncated_to_max_range;
+  rejected_non_finite += other.rejected_non_finite;
+  rejected_out_of_bounds += other.rejected_out_of_bounds;
+  rejected_too_close += other.rejected_too_close;
+  ignored_out_of_range += other.ignored_out_of_range;
+  return *this;
+}
+
+OccupancyState PointOccupancy::state(double occupancy_threshold) const {
+  if (!probability) return OccupancyState::kUnknown;
+  return *probability > occupancy_threshold ? OccupancyState::kOccupied : OccupancyState::kFree;
+}
+
+// ---- Map -----------------------------------------------------------------------------------
+
+Map::Map(const MapConfig& config) : config_(config) {
+  config_.validate();
+  scale_inverse_ = 1.0 / config_.resolution;
+}
+
+Map::~Map() = default;
+Map::Map(Map&&) noexcept = default;
+Map& Map::operator=(Map&&) noexcept = default;
+
+TileIndex Map::tileOf(const CellIndex& cell) {
+  return {cell.x >> kTileSizeLog2, cell.y >> kTileSizeLog2};  // arithmetic shift floors
+}
+
+CellRange Map::tileCells(const TileIndex& tile) {
+  const CellIndex min{tile.x * kTileSize, tile.y * kTileSize};
+  return {min, {min.x + kTileSize - 1, min.y + kTileSize - 1}};
+}
+
+const Map::Tile* Map::findTile(const TileIndex& index) const {
+  const auto it = tiles_.find(packKey(index.x, index.y));
+  return it == tiles_.end() ? nullptr : it->second.get();
+}
+
+const Map::Cell* Map::findCell(const CellIndex& cell) const {
+  const Tile* t = findTile(tileOf(cell));
+  return t == nullptr ? nullptr : &t->at(cell);
+}
+
+CellIndex Map::cellAtPoint(double x, double y) const {
+  return cellAt(x * scale_inverse_, y * scale_inverse_);
+}
+
+CellRange Map::cellsInRectangle(double min_x, double min_y, double max_x, double max_y) const {
+  return {cellAtPoint(min_x, min_y), cellAtPoint(max_x, max_y)};
+}
+
+void Map::growBounds(const CellIndex& cell) {
+  if (bounds_.empty()) {
+    bounds_ = {cell, cell};
+    return;
+  }
+  bounds_.min = {std::min(bounds_.min.x, cell.x), std::min(bounds_.min.y, cell.y)};
+  bounds_.max = {std::max(bounds_.max.x, cell.x), std::max(bounds_.max.y, cell.y)};
+}
+
+bool Map::acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
+                        bool is_obstacle, const InsertionConfig& config,
+                        Eigen::Vector3d& ray_end, bool& obstacle,
+                        InsertionResult& result) const {
+  if (!origin.allFinite() || !end.allFinite()) {
+    ++result.rejected_non_finite;
+    return false;
+  }
+  if (origin.cwiseAbs().maxCoeff() > config_.max_coordinate ||
+      end.cwiseAbs().maxCoeff() > config_.max_coordinate) {
+    ++result.rejected_out_of_bounds;
+    return false;
+  }
+  const Eigen::Vector3d ray = end - origin;
+  const double length = ray.norm();
+  // A zero-length out-of-range reading carries no free space; a zero-length hit is below any
+  // min_range but the sensor itself (decision: both are dropped as too close).
+  if (length == 0.0 || (is_obstacle && length < config.min_range)) {
+    ++result.rejected_too_close;
+    return false;
+  }
+  obstacle = is_obstacle && length <= config.max_range;
+  if (!obstacle && !config.insert_out_of_range) {
+    ++result.ignored_out_of_range;
+    return false;
+  }
+  ray_end = length > config.max_range ? Eigen::Vector3d(origin + ray * (config.max_range / length))
+                                      : end;
+  if (obstacle) {
+    ++result.obstacle_readings;
+  } else {
+    ++result.out_of_range_readings;
+    if (is_obstacle) ++result.truncated_to_max_range;
+  }
+  return true;
+}
+
+namespace {
+
+/// The positive volumes a scan creates, per cell, for the Sec. V.B remedy.
+using ScanPositives = std::unordered_map<std::uint64_t, std::vector<Volume>>;
+
+bool conflictsWithScan(const ScanPositives* positives, const CellIndex& cell,
+                       const Volume& negative) {
+  if (positives == nullptr) return false;
+  const auto it = positives->find(packKey(cell.x, cell.y));
+  if (it == positives->end()) return false;
+  return std::any_of(it->second.begin(), it->second.end(), [&](const Volume& positive) {
+    return positive.bottom < negative.top && negative.bottom < positive.top;
+  });
+}
+
+/// Sec. III-B.2: the volumes one reading creates, handed to emit(cell, sign, volume) in the
+/// order the paper creates them. `start` and `end` are in grid units.
+template <class Emit>
+void volumesOfReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
+                      bool model_negative_space, float unit_mass,
+                      const ScanPositives* scan_positives, Emit&& emit) {
+  auto emit_negative = [&](const CellIndex& cell, double z_a, double z_b) {
+    if (!model_negative_space) return;
+    const Volume negative = makeVolume(static_cast<float>(z_a), static_cast<float>(z_b), unit_mass);
+    if (!conflictsWithScan(scan_positives, cell, negative)) {
+      emit(cell, VolumeSign::kNegative, negative);
+    }
+  };
+  const float end_z = static_cast<float>(end.z());
+  walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
+          [&](const CellIndex& cell, double z_enter, double z_exit, bool is_last) {
+            if (!is_last || !obstacle) {
+              emit_negative(cell, z_enter, z_exit);  // eqs. (3) and (4)
+              return;
+            }
+            const Volume positive = makeVolume(end_z - 0.5f, end_z + 0.5f, unit_mass);  // eq. (5)
+            emit(cell, VolumeSign::kPositive, positive);
+            if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
+              emit_negative(cell, z_enter, z_enter < end.z() ? positive.bottom : positive.top);
+            }
+          });
+}
+
+}  // namespace
+
+/// Finds or creates the tiles that a writer touches, remembering the last one: consecutive cells
+/// of a ray mostly share a tile. `created` (if given) receives new tiles instead of the map, so
+/// that several writers can run at once on disjoint tiles (see insertScan).
+class Map::TileWriter {
+ public:
+  TileWriter(Map& map, std::unordered_map<std::uint64_t, std::unique_ptr<Tile>>* created)
+      : map_(map), created_(created) {}
+
+  Cell& cell(const CellIndex& index) {
+    const TileIndex tile_index = tileOf(index);
+    const std::uint64_t key = packKey(tile_index.x, tile_index.y);
+    if (last_tile_ == nullptr || key != last_key_) {
+      last_key_ = key;
+      last_tile_ = lookup(key);
+      last_tile_->modified_revision = map_.revision_;
+    }
+    return last_tile_->at(index);
+  }
+  void insert(const CellIndex& index, VolumeSign sign, const Volume& volume, float unit_mass) {
+    bytes_added_ += cell(index).insert(sign, volume, unit_mass);
+  }
+  std::ptrdiff_t bytesAdded() const { return bytes_added_; }
+
+ private:
+  Tile* lookup(std::uint64_t key) {
+    if (created_ == nullptr) {
+      std::unique_ptr<Tile>& slot = map_.tiles_[key];
+      if (!slot) slot = std::make_unique<Tile>();
+      return slot.get();
+    }
+    const auto existing = map_.tiles_.find(key);
+    if (existing != map_.tiles_.end()) return existing->second.get();
+    std::unique_ptr<Tile>& slot = (*created_)[key];
+    if (!slot) slot = std::make_unique<Tile>();
+    return slot.get();
+  }
+
+  Map& map_;
+  std::unordered_map<std::uint64_t, std::unique_ptr<Tile>>* created_;
+  std::uint64_t last_key_ = 0;
+  Tile* last_tile_ = nullptr;
+  std::ptrdiff_t bytes_added_ = 0;
+};
+
+InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
+                                   bool is_obstacle, const InsertionConfig& config) {
+  config.validate();
+  InsertionResult result;
+  Eigen::Vector3d ray_end;
+  bool obstacle = false;
+  if (!acceptReading(origin, end, is_obstacle, config, ray_end, obstacle, result)) return result;
+  ++revision_;
+  growBounds(cellAtPoint(origin.x(), origin.y()));
+  growBounds(cellAtPoint(ray_end.x(), ray_end.y()));
+  const float unit_mass = static_cast<float>(1.0 / mass_unit_);
+  TileWriter writer(*this, nullptr);
+  volumesOfReading(origin * scale_inverse_, ray_end * scale_inverse_, obstacle,
+                   config.model_negative_space, unit_mass, nullptr,
+                   [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
+                     writer.insert(cell, sign, volume, unit_mass);
+                   });
+  bytes_in_cells_ += writer.bytesAdded();
+  return result;
+}
+
+InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config) {
+  config.validate();
+  InsertionResult result;
+  struct Reading {
+    Eigen::Vector3d end;  // grid units
+    bool obstacle;
+  };
+  std::vector<Reading> readings;
+  readings.reserve(scan.hits.size() + scan.free_endpoints.size());
+  const Eigen::Vector3d& origin = scan.origin;
+  auto accept = [&](const Eigen::Vector3f& end, bool is_obstacle) {
+    Eigen::Vector3d ray_end;
+    bool obstacle = false;
+    if (acceptReading(origin, end.cast<double>(), is_obstacle, config, ray_end, obstacle,
+                      result)) {
+      growBounds(cellAtPoint(ray_end.x(), ray_end.y()));
+      readings.push_back({ray_end * scale_inverse_, obstacle});
+    }
+  };
+  for (const Eigen::Vector3f& hit : scan.hits) accept(hit, true);
+  for (const Eigen::Vector3f& end : scan.free_endpoints) accept(end, false);
+  if (readings.empty()) return result;
+  ++revision_;
+  growBounds(cellAtPoint(origin.x(), origin.y()));
+
+  const Eigen::Vector3d start = origin * scale_inverse_;
+  const float unit_mass = static_cast<float>(1.0 / mass_unit_);
+  std::unique_ptr<ScanPositives> scan_positives;
+  if (config.clear_conflicting_free_space && config.model_negative_space) {
+    scan_positives = std::make_unique<ScanPositives>();
+    for (const Reading& reading : readings) {
+      if (!reading.obstacle) continue;
+      const auto z = static_cast<float>(reading.end.z());
+      const CellIndex cell = cellAt(reading.end.x(), reading.end.y());
+      (*scan_positives)[packKey(cell.x, cell.y)].push_back(
+          makeVolume(z - 0.5f, z + 0.5f, unit_mass));
+    }
+  }
+  auto volumes_of = [&](const Reading& reading, auto&& emit) {
+    volumesOfReading(start, reading.end, reading.obstacle, config.model_negative_space, unit_mass,
+                     scan_positives.get(), emit);
+  };
+
+  const auto num_threads = static_cast<std::size_t>(config.num_threads);
+  if (num_threads == 1) {
+    TileWriter writer(*this, nullptr);
+    for (const Reading& reading : readings) {
+      volumes_of(reading, [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
+        writer.insert(cell, sign, volume, unit_mass);
+      });
+    }
+    bytes_in_cells_ += writer.bytesAdded();
+    return result;
+  }
+
+  // Several threads, same map: each tile has one owner thread, and every cell receives its
+  // volumes in the same order as in the single-threaded loop above. Phase 1 rasterises slices of
+  // a chunk of readings into per-(slice, owner) buckets; phase 2 lets each owner apply its
+  // buckets slice by slice, i.e. in reading order.
+  struct Contribution {
+    CellIndex cell;
+    Volume volume;
+    VolumeSign sign;
+  };
+  auto owner_of = [num_threads](const CellIndex& cell) {
+    const TileIndex t = tileOf(cell);
+    const auto diagonal = static_cast<std::int64_t>(t.x) + t.y;
+    const auto n = static_cast<std::int64_t>(num_threads);
+    return static_cast<std::size_t>(((diagonal % n) + n) % n);
+  };
+  std::vector<std::vector<std::vector<Contribution>>> buckets(
+      num_threads, std::vector<std::vector<Contribution>>(num_threads));
+  std::vector<std::unordered_map<std::uint64_t, std::unique_ptr<Tile>>> created(num_threads);
+  std::vector<std::ptrdiff_t> bytes_added(num_threads, 0);
+  auto run_parallel = [num_threads](auto&& task) {
+    std::vector<std::thread> workers;
+    for (std::size_t t = 1; t < num_threads; ++t) workers.emplace_back(task, t);
+    task(std::size_t{0});
+    for (std::thread& worker : workers) worker.join();
+  };
+  for (std::size_t chunk = 0; chunk < readings.size(); chunk += kReadingsPerChunk) {
+    const std::size_t chunk_end = std::min(readings.size(), chunk + kReadingsPerChunk);
+    run_parallel([&](std::size_t slice) {
+      const std::size_t per_slice = (chunk_end - chunk + num_threads - 1) / num_threads;
+      const std::size_t begin = std::min(chunk_end, chunk + slice * per_slice);
+      const std::size_t end = std::min(chunk_end, begin + per_slice);
+      for (auto& bucket : buckets[slice]) bucket.clear();
+      for (std::size_t r = begin; r < end; ++r) {
+        volumes_of(readings[r], [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
+          buckets[slice][owner_of(cell)].push_back({cell, volume, sign});
+        });
+      }
+    });
+    run_parallel([&](std::size_t owner) {
+      TileWriter writer(*this, &created[owner]);
+      for (std::size_t slice = 0; slice < num_threads; ++slice) {
+        for (const Contribution& c : buckets[slice][owner]) {
+          writer.insert(c.cell, c.sign, c.volume, unit_mass);
+        }
+      }
+      bytes_added[owner] += writer.bytesAdded();
+    });
+    for (auto& tiles : created) {
+      for (auto& entry : tiles) tiles_.emplace(entry.first, std::move(entry.second));
+      tiles.clear();
+    }
+  }
+  for (std::ptrdiff_t bytes : bytes_added) bytes_in_cells_ += bytes;
+  return result;
+}
+
+// ---- Queries -------------------------------------------------------------------------------
+
+namespace {
+
+/// Eq. (9) from the stored masses of the volumes containing a height: the stored unit cancels,
+/// so decay (which changes only the unit) leaves it exactly unchanged (Sec. III-E).
+std::optional<float> probabilityOf(const Volume* positive, const Volume* negative) {
+  const float rho_plus = positive != nullptr ? positive->density() : 0.0f;
+  const float rho_minus = negative != nullptr ? negative->density() : 0.0f;
+  if (!(rho_plus + rho_minus > 0.0f)) return std::nullopt;
+  return rho_plus / (rho_plus + rho_minus);
+}
+
+}  // namespace
+
+PointOccupancy Map::occupancy(const Eigen::Vector3d& point) const {
+  PointOccupancy result;
+  if (!point.allFinite()) return result;
+  if (point.cwiseAbs().maxCoeff() > config_.max_coordinate) return result;
+  const Cell* cell = findCell(cellAtPoint(point.x(), point.y()));
+  if (cell == nullptr || cell->empty()) return result;
+  const auto z = static_cast<float>(point.z() * scale_inverse_);
+  const Volume* positive =
+      findVolume(cell->list(VolumeSign::kPositive), cell->count(VolumeSign::kPositive), z);
+  const Volume* negative =
+      findVolume(cell->list(VolumeSign::kNegative), cell->count(VolumeSign::kNegative), z);
+  if (positive != nullptr) result.positive_density = positive->density() * mass_unit_;
+  if (negative != nullptr) result.negative_density = negative->density() * mass_unit_;
+  result.probability = probabilityOf(positive, negative);
+  return result;
+}
+
+float Map::realMass(float stored_mass) const {
+  return static_cast<float>(stored_mass * mass_unit_);
+}
+
+CellVolumes Map::cellVolumes(const CellIndex& index) const {
+  CellVolumes result;
+  const Cell* cell = findCell(index);
+  if (cell == nullptr) return result;
+  for (VolumeSign sign : {VolumeSign::kPositive, VolumeSign::kNegative}) {
+    std::vector<Volume>& out = sign == VolumeSign::kPositive ? result.positive : result.negative;
+    const Volume* list = cell->list(sign);
+    for (std::uint32_t k = 0; k < cell->count(sign); ++k) {
+      out.push_back({list[k].bottom, list[k].top, realMass(list[k].mass)});
+    }
+  }
+  return result;
+}
+
+template <class T, class CellValue>
+Grid2D<T> Map::fillGrid(const CellRange& cells, T unobserved, CellValue&& value_of) const {
+  if (cells.empty()) throw ConfigError("cells: the range is empty");
+  if (cells.width() * cells.height() > (std::int64_t{1} << 28)) {
+    throw ConfigError("cells: the range exceeds 2^28 cells");
+  }
+  Grid2D<T> grid;
+  grid.resolution = config_.resolution;
+  grid.cells = cells;
+  grid.values.assign(grid.width() * grid.height(), unobserved);
+  // Walk tile by tile: one lookup per tile, and unobserved tiles are skipped whole.
+  const TileIndex first = tileOf(cells.min);
+  const TileIndex last = tileOf(cells.max);
+  for (std::int32_t ty = first.y; ty <= last.y; ++ty) {
+    for (std::int32_t tx = first.x; tx <= last.x; ++tx) {
+      const Tile* tile = findTile({tx, ty});
+      if (tile == nullptr) continue;
+      const CellRange in_tile = tileCells({tx, ty});
+      const std::int32_t x0 = std::max(in_tile.min.x, cells.min.x);
+      const std::int32_t x1 = std::min(in_tile.max.x, cells.max.x);
+      const std::int32_t y0 = std::max(in_tile.min.y, cells.min.y);
+      const std::int32_t y1 = std::min(in_tile.max.y, cells.max.y);
+      for (std::int32_t y = y0; y <= y1; ++y) {
+        for (std::int32_t x = x0; x <= x1; ++x) {
+          const Cell& cell = tile->at({x, y});
+          if (cell.empty()) continue;
+          grid.values[static_cast<std::size_t>(y - cells.min.y) * grid.width() +
+                      static_cast<std::size_t>(x - cells.min.x)] = value_of(cell);
+        }
+      }
+    }
+  }
+  return grid;
+}
+
+CrossSection Map::crossSection(double z, const CellRange& cells) const {
+  const float unknown = std::numeric_limits<float>::quiet_NaN();
+  if (!std::isfinite(z)) throw ConfigError("z: must be finite");
+  const auto height = static_cast<float>(z * scale_inverse_);
+  return fillGrid<float>(cells, unknown, [&](const Cell& cell) {
+    const std::optional<float> p = probabilityOf(
+        findVolume(cell.list(VolumeSign::kPositive), cell.count(VolumeSign::kPositive), height),
+        findVolume(cell.list(VolumeSign::kNegative), cell.count(VolumeSign::kNegative), height));
+    return p ? *p : unknown;
+  });
+}
+
+namespace {
+
+/// Occupancy of a column over the band [low, high] (grid units), see Map::projection.
+OccupancyState bandState(const Volume* positive, std::uint32_t num_positive,
+                         const Volume* negative, std::uint32_t num_negative, float low,
+                         float high, double occupancy_threshold) {
+  auto in_band = [&](const Volume& v) { return v.top >= low && v.bottom <= high && v.mass > 0; };
+  bool known = std::any_of(negative, negative + num_negative, in_band);
+  for (const Volume* p = positive; p != positive + num_positive; ++p) {
+    if (!in_band(*p)) continue;
+    known = true;
+    // The highest p over this volume's part of the band: where no negative volume covers it,
+    // rho- = 0 and p = 1; negatives are more than 1 apart, so one covers it all or some part
+    // of it is uncovered.
+    const float part_low = std::max(p->bottom, low);
+    const float part_high = std::min(p->top, high);
+    const Volume* cover = std::find_if(negative, negative + num_negative, [&](const Volume& n) {
+      return n.bottom <= part_low && part_high <= n.top;
+    });
+    const float rho_minus = cover != negative + num_negative ? cover->density() : 0.0f;
+    const float rho_plus = p->density();
+    if (rho_plus / (rho_plus + rho_minus) > occupancy_threshold) return OccupancyState::kOccupied;
+  }
+  return known ? OccupancyState::kFree : OccupancyState::kUnknown;
+}
+
+}  // namespace
+
+Projection Map::projection(double z_min, double z_max, double occupancy_threshold,
+                           const CellRange& cells) const {
+  if (std::isnan(z_min) || std::isnan(z_max) || z_min > z_max) {
+    throw ConfigError("z_min: must not be NaN nor above z_max");
+  }
+  if (!(occupancy_threshold >= 0.0 && occupancy_threshold < 1.0)) {
+    throw ConfigError("occupancy_threshold: must be in [0, 1)");
+  }
+  const auto low = static_cast<float>(z_min * scale_inverse_);
+  const auto high = static_cast<float>(z_max * scale_inverse_);
+  return fillGrid<OccupancyState>(cells, OccupancyState::kUnknown, [&](const Cell& cell) {
+    return bandState(cell.list(VolumeSign::kPositive), cell.count(VolumeSign::kPositive),
+                     cell.list(VolumeSign::kNegative), cell.count(VolumeSign::kNegative), low,
+                     high, occupancy_threshold);
+  });
+}
+
+std::vector<std::uint64_t> Map::sortedTileKeys() const {
+  std::vector<std::uint64_t> keys;
+  keys.reserve(tiles_.size());
+  for (const auto& entry : tiles_) keys.push_back(entry.first);
+  std::sort(keys.begin(), keys.end(), [](std::uint64_t a, std::uint64_t b) {
+    // By (y, x) as signed numbers: rows of tiles from the lowest.
+    const auto ax = static_cast<std::int32_t>(a >> 32), ay = static_cast<std::int32_t>(a);
+    const auto bx = static_cast<std::int32_t>(b >> 32), by = static_cast<std::int32_t>(b);
+    return ay != by ? ay < by : ax < bx;
+  });
+  return keys;
+}
+
+void Map::forEachVolumeIn(
+    const CellRange& cells,
+    const std::function<void(const CellIndex&, VolumeSign, const Volume&)>& visit) const {
+  for (std::uint64_t key : sortedTileKeys()) {
+    const TileIndex tile_index{static_cast<std::int32_t>(key >> 32),
+                               static_cast<std::int32_t>(key)};
+    const CellRange tile_cells = tileCells(tile_index);
+    if (tile_cells.max.x < cells.min.x || tile_cells.min.x > cells.max.x ||
+        tile_cells.max.y < cells.min.y || tile_cells.min.y > cells.max.y) {
+      continue;
+    }
+    const Tile& tile = *tiles_.at(key);
+    for (std::int32_t y = tile_cells.min.y; y <= tile_cells.max.y; ++y) {
+      for (std::int32_t x = tile_cells.min.x; x <= tile_cells.max.x; ++x) {
+        const CellIndex index{x, y};
+        const Cell& cell = tile.at(index);
+        if (cell.empty() || !cells.contains(index)) continue;
+        for (VolumeSign sign : {VolumeSign::kPositive, VolumeSign::kNegative}) {
+          const Volume* list = cell.list(sign);
+          for (std::uint32_t k = 0; k < cell.count(sign); ++k) {
+            visit(index, sign, Volume{list[k].bottom, list[k].top, realMass(list[k].mass)});
+          }
+        }
+      }
+    }
+  }
+}
+
+void Map::forEachVolume(
+    const std::function<void(const CellIndex&, VolumeSign, const Volume&)>& visit) const {
+  forEachVolumeIn(bounds_, visit);
+}
+
+// ---- Decay, bookkeeping ------------------------------------------------------------------------
+
+void Map::decay(double k_d) {
+  if (!(k_d > 0.0 && k_d <= 1.0)) throw ConfigError("k_d: must be in (0, 1]");
+  mass_unit_ *= k_d;
+  // Keep stored masses (real / unit) far from float overflow: once the unit falls below 2^-64,
+  // fold its binary exponent into every stored mass. Multiplying by a power of two is exact, so
+  // no probability changes.
+  if (mass_unit_ < 0x1p-64) {
+    const int exponent = std::ilogb(mass_unit_);
+    for (auto& entry : tiles_) {
+      for (Cell& cell : entry.second->cells) cell.scaleMasses(exponent);
+    }
+    mass_unit_ = std::ldexp(mass_unit_, -exponent);
+  }
+}
+
+MemoryUsage Map::memoryUsage() const {
+  MemoryUsage usage;
+  usage.tiles = tiles_.size();
+  for (const auto& entry : tiles_) {
+    for (const Cell& cell : entry.second->cells) {
+      if (cell.empty()) continue;
+      ++usage.cells_with_volumes;
+      usage.positive_volumes += cell.count(VolumeSign::kPositive);
+      usage.negative_volumes += cell.count(VolumeSign::kNegative);
+    }
+  }
+  const std::size_t tile_index_bytes =
+      tiles_.bucket_count() * sizeof(void*) +
+      tiles_.size() * (sizeof(void*) + sizeof(decltype(tiles_)::value_type));
+  usage.bytes_held = sizeof(Map) + tile_index_bytes + tiles_.size() * sizeof(Tile) + bytes_in_cells_;
+  usage.minimal_grid_cells = static_cast<std::size_t>(bounds_.width() * bounds_.height());
+  usage.table_one_bytes = usage.minimal_grid_cells * 8 +
+                          (usage.positive_volumes + usage.negative_volumes) * sizeof(Volume);
+  return usage;
+}
+
+void Map::clear() {
+  tiles_.clear();
+  bounds_ = CellRange{{0, 0}, {-1, -1}};
+  bytes_in_cells_ = 0;
+  mass_unit_ = 1.0;
+  ++revision_;
+}
+
+std::vector<TileIndex> Map::tilesModifiedSince(std::uint64_t revision) const {
+  std::vector<TileIndex> modified;
+  for (std::uint64_t key : sortedTileKeys()) {
+    if (tiles_.at(key)->modified_revision > revision) {
+      modified.push_back({static_cast<std::int32_t>(key >> 32), static_cast<std::int32_t>(key)});
+    }
+  }
+  return modified;
+}
+
+void Map::setCellVolumes(const CellIndex& index, const CellVolumes& volumes) {
+  for (VolumeSign sign : {VolumeSign::kPositive, VolumeSign::kNegative}) {
+    const std::vector<Volume>& list =
+        sign == VolumeSign::kPositive ? volumes.positive : volumes.negative;
+    const std::string problem = checkVolumeList(list.data(), list.size());
+    if (!problem.empty()) {
+      throw ConfigError(std::string(sign == VolumeSign::kPositive ? "positive" : "negative") +
+                        " volumes: " + problem);
+    }
+  }
+  CellVolumes stored = volumes;
+  for (std::vector<Volume>* list : {&stored.positive, &stored.negative}) {
+    for (Volume& v : *list) v.mass = static_cast<float>(v.mass / mass_unit_);
+  }
+  ++revision_;
+  TileWriter writer(*this, nullptr);
+  bytes_in_cells_ += writer.cell(index).assign(stored);
+  if (!stored.positive.empty() || !stored.negative.empty()) growBounds(index);
+}
+
+}  // namespace mvog

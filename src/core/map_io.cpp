@@ -1,0 +1,284 @@
+#include "mvog/map_io.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <unordered_set>
+
+namespace mvog {
+namespace {
+
+constexpr char kMagic[8] = {'M', 'V', 'O', 'G', 'M', 'A', 'P', '\0'};
+constexpr std::size_t kCellRecordBytes = 16;
+constexpr std::size_t kChecksumBytes = 8;
+
+static_assert(sizeof(float) == 4 && sizeof(double) == 8, "IEEE 754 sizes assumed");
+
+std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
+  std::uint64_t hash = 0xcbf29ce484222325ull;
+  for (std::size_t k = 0; k < size; ++k) {
+    hash ^= data[k];
+    hash *= 0x100000001b3ull;
+  }
+  return hash;
+}
+
+/// Appends values little-endian, whatever the host's byte order.
+class Writer {
+ public:
+  explicit Writer(std::vector<std::uint8_t>& out) : out_(out) {}
+  void bytes(const void* data, std::size_t size) {
+    const auto* p = static_cast<const std::uint8_t*>(data);
+    for (std::size_t k = 0; k < size; ++k) out_.push_back(p[k]);
+  }
+  void u32(std::uint32_t v) { unsignedLe(v, 4); }
+  void u64(std::uint64_t v) { unsignedLe(v, 8); }
+  void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
+  void f32(float v) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &v, 4);
+    u32(bits);
+  }
+  void f64(double v) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &v, 8);
+    u64(bits);
+  }
+
+ private:
+  void unsignedLe(std::uint64_t v, int size) {
+    for (int k = 0; k < size; ++k) out_.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
+  }
+  std::vector<std::uint8_t>& out_;
+};
+
+/// Reads little-endian values; the caller has checked that they are there.
+class Reader {
+ public:
+  Reader(const std::uint8_t* data, std::size_t offset) : data_(data), offset_(offset) {}
+  std::uint32_t u32() { return static_cast<std::uint32_t>(unsignedLe(4)); }
+  std::uint64_t u64() { return unsignedLe(8); }
+  std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
+  float f32() {
+    const std::uint32_t bits = u32();
+    float v;
+    std::memcpy(&v, &bits, 4);
+    return v;
+  }
+  double f64() {
+    const std::uint64_t bits = u64();
+    double v;
+    std::memcpy(&v, &bits, 8);
+    return v;
+  }
+  std::size_t offset() const { return offset_; }
+
+ private:
+  std::uint64_t unsignedLe(int size) {
+    std::uint64_t v = 0;
+    for (int k = 0; k < size; ++k) v |= std::uint64_t{data_[offset_ + k]} << (8 * k);
+    offset_ += static_cast<std::size_t>(size);
+    return v;
+  }
+  const std::uint8_t* data_;
+  std::size_t offset_;
+};
+
+[[noreturn]] void fail(const std::string& what) { throw MapFileError("invalid map: " + what); }
+
+std::string systemError(const std::string& what, const std::string& path) {
+  return what + " '" + path + "': " + std::strerror(errno);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> serializeMap(const Map& map) {
+  // Group the volumes by cell (forEachVolume gives a cell's positives, then its negatives).
+  struct CellRecord {
+    CellIndex cell;
+    CellVolumes volumes;
+  };
+  std::vector<CellRecord> cells;
+  std::size_t volume_count = 0;
+  map.forEachVolume([&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
+    if (cells.empty() || cells.back().cell != cell) cells.push_back({cell, {}});
+    (sign == VolumeSign::kPositive ? cells.back().volumes.positive : cells.back().volumes.negative)
+        .push_back(volume);
+    ++volume_count;
+  });
+
+  std::vector<std::uint8_t> out;
+  out.reserve(kMapHeaderBytes + kCellRecordBytes * cells.size() +
+              sizeof(Volume) * volume_count + kChecksumBytes);
+  Writer writer(out);
+  writer.bytes(kMagic, sizeof(kMagic));
+  writer.u32(kMapFormatVersion);
+  writer.u32(static_cast<std::uint32_t>(kMapHeaderBytes));
+  writer.f64(map.config().resolution);
+  writer.f64(map.config().max_coordinate);
+  writer.u64(cells.size());
+  writer.u64(volume_count);
+  writer.u64(0);
+  writer.u64(0);
+  for (const CellRecord& record : cells) {
+    writer.i32(record.cell.x);
+    writer.i32(record.cell.y);
+    writer.u32(static_cast<std::uint32_t>(record.volumes.positive.size()));
+    writer.u32(static_cast<std::uint32_t>(record.volumes.negative.size()));
+    for (const std::vector<Volume>* list : {&record.volumes.positive, &record.volumes.negative}) {
+      for (const Volume& v : *list) {
+        writer.f32(v.bottom);
+        writer.f32(v.top);
+        writer.f32(v.mass);
+      }
+    }
+  }
+  writer.u64(fnv1a64(out.data(), out.size()));
+  return out;
+}
+
+Map deserializeMap(const std::uint8_t* data, std::size_t size) {
+  if (data == nullptr || size < kMapHeaderBytes + kChecksumBytes) {
+    fail("truncated: " + std::to_string(size) + " bytes is less than a header and a checksum");
+  }
+  if (std::memcmp(data, kMagic, sizeof(kMagic)) != 0) fail("not an MVOG map (bad magic)");
+  Reader header(data, sizeof(kMagic));
+  const std::uint32_t version = header.u32();
+  if (version != kMapFormatVersion) {
+    fail("format version " + std::to_string(version) + " is not supported (expected " +
+         std::to_string(kMapFormatVersion) + ")");
+  }
+  if (header.u32() != kMapHeaderBytes) fail("unexpected header size");
+  MapConfig config;
+  config.resolution = header.f64();
+  config.max_coordinate = header.f64();
+  const std::uint64_t cell_count = header.u64();
+  const std::uint64_t volume_count = header.u64();
+  if (header.u64() != 0 || header.u64() != 0) fail("reserved header bytes are not zero");
+  // Check the counts against the real size before trusting them for anything.
+  const std::size_t body = size - kMapHeaderBytes - kChecksumBytes;
+  if (cell_count > body / kCellRecordBytes || volume_count > body / sizeof(Volume) ||
+      cell_count * kCellRecordBytes + volume_count * sizeof(Volume) != body) {
+    fail("the header's counts (" + std::to_string(cell_count) + " cells, " +
+         std::to_string(volume_count) + " volumes) do not match the size of " +
+         std::to_string(size) + " bytes (truncated or corrupted)");
+  }
+  const std::size_t checksum_offset = size - kChecksumBytes;
+  if (Reader(data, checksum_offset).u64() != fnv1a64(data, checksum_offset)) {
+    fail("checksum mismatch (corrupted)");
+  }
+  Map map = [&] {
+    try {
+      return Map(config);
+    } catch (const ConfigError& e) {
+      fail(std::string("bad header: ") + e.what());
+    }
+  }();
+
+  Reader reader(data, kMapHeaderBytes);
+  std::unordered_set<std::uint64_t> seen;
+  std::uint64_t volumes_read = 0;
+  const double max_cell = config.max_coordinate / config.resolution + 1.0;
+  for (std::uint64_t c = 0; c < cell_count; ++c) {
+    const CellIndex cell{reader.i32(), reader.i32()};
+    const std::uint64_t num_positive = reader.u32();
+    const std::uint64_t num_negative = reader.u32();
+    const std::string where = "cell (" + std::to_string(cell.x) + ", " + std::to_string(cell.y) + ")";
+    if (num_positive + num_negative == 0) fail(where + " holds no volume");
+    if (volumes_read + num_positive + num_negative > volume_count) {
+      fail(where + " holds more volumes than the header counts");
+    }
+    if (std::fabs(static_cast<double>(cell.x)) > max_cell ||
+        std::fabs(static_cast<double>(cell.y)) > max_cell) {
+      fail(where + " lies beyond max_coordinate");
+    }
+    const std::uint64_t key =
+        (std::uint64_t{static_cast<std::uint32_t>(cell.x)} << 32) | static_cast<std::uint32_t>(cell.y);
+    if (!seen.insert(key).second) fail(where + " appears twice");
+    CellVolumes volumes;
+    volumes.positive.resize(num_positive);
+    volumes.negative.resize(num_negative);
+    for (std::vector<Volume>* list : {&volumes.positive, &volumes.negative}) {
+      for (Volume& v : *list) v = Volume{reader.f32(), reader.f32(), reader.f32()};
+    }
+    volumes_read += num_positive + num_negative;
+    try {
+      map.setCellVolumes(cell, volumes);
+    } catch (const ConfigError& e) {
+      fail(where + ": " + e.what());
+    }
+  }
+  if (volumes_read != volume_count) fail("fewer volumes than the header counts");
+  return map;
+}
+
+void saveMap(const Map& map, const std::string& path) {
+  const std::vector<std::uint8_t> bytes = serializeMap(map);
+  std::string temporary = path + ".tmp.XXXXXX";
+  const int fd = mkstemp(temporary.data());
+  if (fd < 0) throw MapFileError(systemError("cannot create a temporary file beside", path));
+  auto abandon = [&](const std::string& what) {
+    const std::string message = systemError(what, temporary);
+    ::close(fd);
+    ::unlink(temporary.c_str());
+    throw MapFileError(message);
+  };
+  std::size_t written = 0;
+  while (written < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) abandon("cannot write");
+    written += static_cast<std::size_t>(n);
+  }
+  if (::fchmod(fd, 0644) != 0) abandon("cannot set the permissions of");
+  if (::fsync(fd) != 0) abandon("cannot flush");
+  if (::close(fd) != 0) {
+    const std::string message = systemError("cannot close", temporary);
+    ::unlink(temporary.c_str());
+    throw MapFileError(message);
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const std::string message = systemError("cannot rename the temporary file to", path);
+    ::unlink(temporary.c_str());
+    throw MapFileError(message);
+  }
+  // Make the rename itself durable.
+  const std::size_t slash = path.find_last_of('/');
+  const std::string directory = slash == std::string::npos ? "." : path.substr(0, slash + 1);
+  const int dir_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+}
+
+Map loadMap(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) throw MapFileError(systemError("cannot open", path));
+  struct stat status {};
+  if (::fstat(fd, &status) != 0 || !S_ISREG(status.st_mode)) {
+    ::close(fd);
+    throw MapFileError("not a regular file: '" + path + "'");
+  }
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(status.st_size));
+  std::size_t read_bytes = 0;
+  while (read_bytes < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + read_bytes, bytes.size() - read_bytes);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    read_bytes += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  if (read_bytes != bytes.size()) throw MapFileError("cannot read all of '" + path + "'");
+  try {
+    return deserializeMap(bytes.data(), bytes.size());
+  } catch (const MapFileError& e) {
+    throw MapFileError("'" + path + "': " + e.what());
+  }
+}
+
+}  // namespace mvog
