@@ -1,0 +1,63 @@
+# Shared by scripts/demo.sh and scripts/test.sh: installs what is missing and builds, quietly.
+# Source it; it defines REPO, WORKSPACE and the functions below.
+set -euo pipefail
+# Debian's python3 must come first: a pyenv python3 breaks catkin, pluginlib, rosrun and rostest.
+export PATH=/usr/bin:$PATH
+REPO=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+WORKSPACE=${MVOG_WORKSPACE:-$REPO/.ws}
+LOG_DIR=$WORKSPACE/logs
+export MVOG_DATA_DIR=${MVOG_DATA_DIR:-$(cd "$REPO/.." && pwd)/shared/data}
+
+# Debian 12 packages: ROS 1 (Debian's own build), PCL, OctoMap, test and headless-rviz tools.
+MVOG_PACKAGES=(
+  build-essential cmake libeigen3-dev libgtest-dev libbenchmark-dev
+  ros-core-python-dev ros-base-dev python3-rostest rosbash python3-rosbag python3-numpy
+  libpcl-ros-dev libpcl-conversions-dev libtf2-ros-dev libtf2-sensor-msgs-dev libtf2-eigen-dev
+  libtf2-geometry-msgs-dev liblaser-geometry-dev libstd-srvs-dev libvisualization-msgs-dev
+  libnav-msgs-dev libmap-msgs-dev libdiagnostic-msgs-dev rviz tf2-tools liboctomap-dev octomap-tools
+  xvfb xauth libgl1-mesa-dri imagemagick
+)
+
+as_root() {
+  if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
+}
+
+# Runs a command with its output in a log file; prints the log's end only if it fails.
+quietly() {
+  local name=$1
+  shift
+  mkdir -p "$LOG_DIR"
+  if ! "$@" >"$LOG_DIR/$name.log" 2>&1; then
+    echo "FAILED: $* (log: $LOG_DIR/$name.log)" >&2
+    tail -n 60 "$LOG_DIR/$name.log" >&2
+    return 1
+  fi
+}
+
+install_missing_packages() {
+  local missing=()
+  for package in "${MVOG_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q 'install ok installed' ||
+      missing+=("$package")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "installing ${#missing[@]} missing Debian packages: ${missing[*]}"
+  quietly apt-update as_root apt-get update
+  quietly apt-install as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y \
+    --no-install-recommends "${missing[@]}"
+}
+
+# The catkin workspace links the repository as its only package.
+build_workspace() {
+  mkdir -p "$WORKSPACE/src"
+  ln -sfn "$REPO" "$WORKSPACE/src/mvog"
+  quietly catkin_make bash -c "cd '$WORKSPACE' && catkin_make -DCMAKE_BUILD_TYPE=Release \
+    -DCATKIN_ENABLE_TESTING=ON -j2 $*"
+}
+
+source_workspace() {
+  set +u
+  # shellcheck disable=SC1091
+  source "$WORKSPACE/devel/setup.bash"
+  set -u
+}

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds (Release) and runs every test: the core alone with plain CMake
+# (no ROS), then the catkin package's gtests and rostests. Prints one summary line and exits
+# non-zero on any failure. Tests that replay ../shared/data skip without it, but not when CI=true.
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+
+install_missing_packages
+
+passed=0
+failed=0
+skipped=0
+failures=()
+
+# 1. The core with plain CMake: proves it builds and passes without catkin.
+core_build=$WORKSPACE/core_build
+quietly core-configure cmake -S "$REPO" -B "$core_build" -DMVOG_BUILD_ROS=OFF \
+  -DCMAKE_BUILD_TYPE=Release
+quietly core-build cmake --build "$core_build" -j2
+if (cd "$core_build" && ctest --output-on-failure >"$LOG_DIR/core-ctest.log" 2>&1); then :; else
+  failures+=("core (plain CMake): see $LOG_DIR/core-ctest.log")
+fi
+core_counts=$(grep -E 'tests passed, [0-9]+ tests failed' "$LOG_DIR/core-ctest.log" || true)
+core_total=$(sed -E 's/.* out of ([0-9]+).*/\1/' <<<"$core_counts")
+core_failed=$(sed -E 's/.*passed, ([0-9]+) tests failed.*/\1/' <<<"$core_counts")
+passed=$((passed + ${core_total:-0} - ${core_failed:-0}))
+failed=$((failed + ${core_failed:-1}))
+
+# 2. The catkin package: gtests and rostests.
+build_workspace
+source_workspace
+rm -rf "$WORKSPACE/build/test_results"
+quietly run-tests bash -c "cd '$WORKSPACE' && catkin_make run_tests -j2" || true
+results=$(catkin_test_results --all "$WORKSPACE/build/test_results" 2>&1 || true)
+echo "$results" >"$LOG_DIR/catkin-test-results.log"
+summary=$(grep -E '^Summary:' <<<"$results" || echo "Summary: 0 tests, 1 errors, 0 failures, 0 skipped")
+read -r tests errors test_failures test_skipped < <(sed -E \
+  's/Summary: ([0-9]+) tests, ([0-9]+) errors, ([0-9]+) failures, ([0-9]+) skipped.*/\1 \2 \3 \4/' \
+  <<<"$summary")
+passed=$((passed + tests - errors - test_failures - test_skipped))
+failed=$((failed + errors + test_failures))
+skipped=$((skipped + test_skipped))
+if [ $((errors + test_failures)) -gt 0 ] || [ "$tests" -eq 0 ]; then
+  failures+=("catkin tests: $(grep -vE '^Summary:' <<<"$results" | grep -E 'errors|failures|Error' | head -20)")
+fi
+
+for failure in "${failures[@]}"; do echo "FAILED: $failure"; done
+echo "tests: $passed passed, $failed failed, $skipped skipped"
+[ "$failed" -eq 0 ] && [ ${#failures[@]} -eq 0 ]

@@ -1,0 +1,133 @@
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <message_filters/subscriber.h>
+#include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/message_filter.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "mapper_config.h"
+#include "mvog/GetCrossSection.h"
+#include "mvog/GetOccupancy.h"
+#include "mvog/MapFile.h"
+#include "mvog/map.h"
+#include "visualization.h"
+
+namespace mvog_ros {
+
+/// The mapping server: subscribes to range sensors, feeds the MVOG core, publishes the map and
+/// answers queries. Shared by the nodelet and the node. Callbacks may run on several threads:
+/// the map is guarded by a readers-writer lock, and insertion runs on its own thread behind a
+/// bounded queue that drops the oldest message when the sensors outpace it.
+class Mapper {
+ public:
+  /// Throws mvog::ConfigError (naming the parameter) or mvog::MapFileError (~map_file).
+  Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  ~Mapper();
+  Mapper(const Mapper&) = delete;
+  Mapper& operator=(const Mapper&) = delete;
+
+ private:
+  template <class Message>
+  struct SensorInput {
+    std::unique_ptr<message_filters::Subscriber<Message>> subscriber;
+    std::unique_ptr<tf2_ros::MessageFilter<Message>> filter;
+  };
+  struct PendingScan {
+    mvog::Scan scan;
+    std::string source;
+  };
+  struct Counters {
+    std::atomic<std::uint64_t> readings_inserted{0};
+    std::atomic<std::uint64_t> readings_rejected{0};
+    std::atomic<std::uint64_t> messages_inserted{0};
+    std::atomic<std::uint64_t> messages_dropped_tf{0};
+    std::atomic<std::uint64_t> messages_dropped_queue{0};
+    std::atomic<std::uint64_t> messages_dropped_invalid{0};
+    std::atomic<std::uint64_t> insertion_nanoseconds{0};
+    void reset();
+  };
+
+  template <class Message>
+  void subscribe(const std::string& topic, std::vector<SensorInput<Message>>& inputs);
+  void onScan(const sensor_msgs::LaserScanConstPtr& scan);
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud);
+  bool sensorPose(const std_msgs::Header& header, Eigen::Isometry3d& map_from_sensor);
+  void rejectMessage(const std::string& topic_kind, const std::string& why);
+  void enqueue(PendingScan&& pending);
+  void insertionLoop();
+
+  void publishChanges(const ros::TimerEvent&);
+  void publishBinaryMap(const ros::TimerEvent&);
+  void publishStatistics(const ros::TimerEvent&);
+  void decay(const ros::TimerEvent&);
+  void autosave(const ros::TimerEvent&);
+  void sendAllMarkers(const ros::SingleSubscriberPublisher& subscriber, bool occupied_only);
+  void sendGrid(const ros::SingleSubscriberPublisher& subscriber, std::size_t layer);
+  void sendBinaryMap(const ros::SingleSubscriberPublisher& subscriber);
+  /// Forgets every published tile and grid: the next publication starts from scratch.
+  void restartPublication();
+
+  bool getOccupancy(mvog::GetOccupancy::Request& request, mvog::GetOccupancy::Response& response);
+  bool getCrossSection(mvog::GetCrossSection::Request& request,
+                       mvog::GetCrossSection::Response& response);
+  bool saveMap(mvog::MapFile::Request& request, mvog::MapFile::Response& response);
+  bool loadMap(mvog::MapFile::Request& request, mvog::MapFile::Response& response);
+  bool reset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  /// Replaces the map (load): under the write lock, and publication restarts.
+  void replaceMap(mvog::Map&& map);
+
+  ros::NodeHandle nh_;
+  ros::NodeHandle private_nh_;
+  const MapperConfig config_;
+
+  mutable std::shared_mutex map_mutex_;
+  mvog::Map map_;
+
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  std::vector<SensorInput<sensor_msgs::LaserScan>> scan_inputs_;
+  std::vector<SensorInput<sensor_msgs::PointCloud2>> cloud_inputs_;
+
+  std::mutex queue_mutex_;
+  std::condition_variable queue_changed_;
+  std::deque<PendingScan> queue_;
+  bool stopping_ = false;
+  std::thread insertion_thread_;
+
+  std::mutex publish_mutex_;  // the publication state below
+  std::uint64_t published_revision_ = 0;
+  std::uint64_t binary_revision_ = 0;
+  std::uint64_t saved_revision_ = 0;
+  /// Layer 0 is the projected map, then one per ~cross_section_heights entry.
+  std::vector<IncrementalGrid> grids_;
+
+  Counters counters_;
+  std::uint64_t readings_at_last_statistics_ = 0;
+  ros::WallTime last_statistics_time_;
+
+  ros::Publisher volumes_publisher_;
+  ros::Publisher occupied_publisher_;
+  std::vector<ros::Publisher> grid_publishers_;
+  std::vector<ros::Publisher> grid_update_publishers_;
+  ros::Publisher binary_map_publisher_;
+  ros::Publisher statistics_publisher_;
+  std::vector<ros::ServiceServer> services_;
+  std::vector<ros::Timer> timers_;
+};
+
+}  // namespace mvog_ros

@@ -1,0 +1,152 @@
+#include "mapper_config.h"
+
+#include <cmath>
+#include <cstdlib>
+
+namespace mvog_ros {
+namespace {
+
+void require(bool condition, const std::string& parameter, const std::string& reason) {
+  if (!condition) throw mvog::ConfigError("~" + parameter + ": " + reason);
+}
+
+/// Reads an optional parameter, checking its type: a value of another type is an error, not a
+/// silent default.
+template <class T>
+void read(const ros::NodeHandle& nh, const std::string& name, T& value) {
+  if (!nh.hasParam(name)) return;
+  if (!nh.getParam(name, value)) {
+    throw mvog::ConfigError("~" + name + ": has the wrong type");
+  }
+}
+
+void read(const ros::NodeHandle& nh, const std::string& name, double& value) {
+  if (!nh.hasParam(name)) return;
+  // Accept integers and floats alike (YAML writes 1 for 1.0).
+  XmlRpc::XmlRpcValue raw;
+  nh.getParam(name, raw);
+  if (raw.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+    value = static_cast<int>(raw);
+  } else if (raw.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+    value = static_cast<double>(raw);
+  } else {
+    throw mvog::ConfigError("~" + name + ": must be a number");
+  }
+}
+
+void read(const ros::NodeHandle& nh, const std::string& name, std::vector<double>& values) {
+  if (!nh.hasParam(name)) return;
+  XmlRpc::XmlRpcValue raw;
+  nh.getParam(name, raw);
+  if (raw.getType() != XmlRpc::XmlRpcValue::TypeArray) {
+    throw mvog::ConfigError("~" + name + ": must be a list of numbers");
+  }
+  values.clear();
+  for (int k = 0; k < raw.size(); ++k) {
+    if (raw[k].getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      values.push_back(static_cast<int>(raw[k]));
+    } else if (raw[k].getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      values.push_back(static_cast<double>(raw[k]));
+    } else {
+      throw mvog::ConfigError("~" + name + ": must be a list of numbers");
+    }
+  }
+}
+
+std::string defaultMapDirectory() {
+  if (const char* ros_home = std::getenv("ROS_HOME")) return std::string(ros_home) + "/mvog_maps";
+  if (const char* home = std::getenv("HOME")) return std::string(home) + "/.ros/mvog_maps";
+  return "mvog_maps";
+}
+
+}  // namespace
+
+void MapperConfig::validate() const {
+  // The core's own checks name their field; prefix them with the parameter's ~.
+  try {
+    map.validate();
+    insertion.validate();
+  } catch (const mvog::ConfigError& e) {
+    std::string message = e.what();
+    if (message.rfind("num_threads", 0) == 0) message.replace(0, 11, "insertion_threads");
+    throw mvog::ConfigError("~" + message);
+  }
+  require(!frame_id.empty(), "frame_id", "must not be empty");
+  require(sensor_queue_size >= 1 && sensor_queue_size <= 1000, "sensor_queue_size",
+          "must be in [1, 1000]");
+  require(insertion_queue_size >= 1 && insertion_queue_size <= 1000, "insertion_queue_size",
+          "must be in [1, 1000]");
+  require(std::isfinite(tf_timeout) && tf_timeout >= 0.0, "tf_timeout",
+          "must be a finite number >= 0");
+  require(std::isfinite(voxel_filter_size) && voxel_filter_size >= 0.0, "voxel_filter_size",
+          "must be a finite number >= 0 (0: off)");
+  require(max_points_per_message >= 1, "max_points_per_message", "must be >= 1");
+  require(std::isfinite(decay_factor) && decay_factor > 0.0 && decay_factor <= 1.0,
+          "decay_factor", "must be in (0, 1]");
+  require(std::isfinite(decay_period) && decay_period >= 0.0, "decay_period",
+          "must be a finite number >= 0 (0: off)");
+  require(std::isfinite(occupancy_threshold) && occupancy_threshold >= 0.0 &&
+              occupancy_threshold < 1.0,
+          "occupancy_threshold", "must be in [0, 1)");
+  for (double height : cross_section_heights) {
+    require(std::isfinite(height) && std::fabs(height) <= map.max_coordinate,
+            "cross_section_heights", "every height must be finite and within max_coordinate");
+  }
+  require(!std::isnan(projection_min_z) && !std::isnan(projection_max_z) &&
+              projection_min_z <= projection_max_z,
+          "projection_min_z", "must not be NaN nor above ~projection_max_z");
+  require(std::isfinite(publish_period) && publish_period > 0.0, "publish_period",
+          "must be a finite number > 0");
+  require(std::isfinite(binary_map_period) && binary_map_period >= 0.0, "binary_map_period",
+          "must be a finite number >= 0 (0: off)");
+  require(std::isfinite(statistics_period) && statistics_period > 0.0, "statistics_period",
+          "must be a finite number > 0");
+  require(!map_directory.empty(), "map_directory", "must not be empty");
+  require(std::isfinite(autosave_period) && autosave_period >= 0.0, "autosave_period",
+          "must be a finite number >= 0 (0: off)");
+  require(autosave_period == 0.0 || !autosave_file.empty(), "autosave_file",
+          "must not be empty when ~autosave_period is set");
+  require(max_query_points >= 1, "max_query_points", "must be >= 1");
+  require(max_cross_section_cells >= 1, "max_cross_section_cells", "must be >= 1");
+}
+
+MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
+  MapperConfig config;
+  config.map_directory = defaultMapDirectory();
+  const ros::NodeHandle& nh = private_nh;
+  read(nh, "resolution", config.map.resolution);
+  read(nh, "max_coordinate", config.map.max_coordinate);
+  read(nh, "min_range", config.insertion.min_range);
+  read(nh, "max_range", config.insertion.max_range);
+  read(nh, "insert_out_of_range", config.insertion.insert_out_of_range);
+  read(nh, "model_negative_space", config.insertion.model_negative_space);
+  read(nh, "clear_conflicting_free_space", config.insertion.clear_conflicting_free_space);
+  read(nh, "insertion_threads", config.insertion.num_threads);
+  read(nh, "frame_id", config.frame_id);
+  read(nh, "scan_topics", config.scan_topics);
+  read(nh, "cloud_topics", config.cloud_topics);
+  read(nh, "sensor_queue_size", config.sensor_queue_size);
+  read(nh, "insertion_queue_size", config.insertion_queue_size);
+  read(nh, "tf_timeout", config.tf_timeout);
+  read(nh, "voxel_filter_size", config.voxel_filter_size);
+  read(nh, "max_points_per_message", config.max_points_per_message);
+  read(nh, "decay_factor", config.decay_factor);
+  read(nh, "decay_period", config.decay_period);
+  read(nh, "occupancy_threshold", config.occupancy_threshold);
+  read(nh, "cross_section_heights", config.cross_section_heights);
+  read(nh, "projection_min_z", config.projection_min_z);
+  read(nh, "projection_max_z", config.projection_max_z);
+  read(nh, "publish_period", config.publish_period);
+  read(nh, "binary_map_period", config.binary_map_period);
+  read(nh, "statistics_period", config.statistics_period);
+  read(nh, "map_directory", config.map_directory);
+  read(nh, "map_file", config.map_file);
+  read(nh, "autosave_period", config.autosave_period);
+  read(nh, "autosave_file", config.autosave_file);
+  read(nh, "max_query_points", config.max_query_points);
+  read(nh, "max_cross_section_cells", config.max_cross_section_cells);
+  config.validate();
+  return config;
+}
+
+}  // namespace mvog_ros

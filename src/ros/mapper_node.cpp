@@ -1,0 +1,18 @@
+// The mapping server as a standalone node (the same Mapper as the nodelet).
+#include <ros/ros.h>
+
+#include "mapper.h"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "mvog_mapper");
+  try {
+    mvog_ros::Mapper mapper(ros::NodeHandle(), ros::NodeHandle("~"));
+    ros::AsyncSpinner spinner(4);  // queries and publication beside the sensor callbacks
+    spinner.start();
+    ros::waitForShutdown();
+  } catch (const std::exception& e) {
+    ROS_FATAL("mvog: cannot start: %s", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,71 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <map_msgs/OccupancyGridUpdate.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "mvog/map.h"
+
+namespace mvog_ros {
+
+/// Marker ids are per tile, so that a tile's markers are replaced when it changes (and only
+/// then): publication costs what changed, not the whole map.
+int tileMarkerId(const mvog::TileIndex& tile);
+
+/// The volumes of one tile as two TRIANGLE_LIST boxes markers: namespace "positive" (red) and
+/// "negative" (blue) (Fig. 4, middle). An empty list becomes a DELETE of that tile's marker.
+void appendVolumeMarkers(const mvog::Map& map, const mvog::TileIndex& tile,
+                         const std::string& frame_id, const ros::Time& stamp,
+                         visualization_msgs::MarkerArray& markers);
+
+/// The space of one tile with p > occupancy_threshold as boxes coloured by height (Fig. 4,
+/// right), namespace "occupied".
+void appendOccupiedMarkers(const mvog::Map& map, const mvog::TileIndex& tile,
+                           double occupancy_threshold, const std::string& frame_id,
+                           const ros::Time& stamp, visualization_msgs::MarkerArray& markers);
+
+/// A marker that clears every marker of the topic (after a reset or a load).
+visualization_msgs::Marker deleteAllMarker(const std::string& frame_id, const ros::Time& stamp);
+
+/// The occupancy grid value of a probability (0..100) or of unknown (-1).
+std::int8_t gridValue(float probability);
+std::int8_t gridValue(mvog::OccupancyState state);
+
+/// A nav_msgs/OccupancyGrid of a core grid, at height `z` (the grid's origin height).
+template <class T>
+nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::Grid2D<T>& grid, double z,
+                                        const std::string& frame_id, const ros::Time& stamp);
+
+/// A 2D layer of the map (the projected map or one cross-section) kept up to date tile by tile.
+/// It covers whole tiles around the map's bounds, with a margin so that a growing map seldom
+/// makes it re-lay itself out.
+class IncrementalGrid {
+ public:
+  /// compute(map, cells) evaluates the layer over a range of cells.
+  using Compute = std::function<nav_msgs::OccupancyGrid::_data_type(const mvog::Map&,
+                                                                   const mvog::CellRange&)>;
+  IncrementalGrid(double z, Compute compute) : z_(z), compute_(std::move(compute)) {}
+
+  /// Brings the grid up to date with the tiles changed since the last update. Returns the
+  /// rectangle that changed (for an OccupancyGridUpdate), or the whole grid after a re-layout.
+  mvog::CellRange update(const mvog::Map& map, const std::vector<mvog::TileIndex>& changed,
+                         bool& relaid_out);
+  void clear() { grid_ = nav_msgs::OccupancyGrid(); }
+  const nav_msgs::OccupancyGrid& grid() const { return grid_; }
+  /// The part of the grid over `cells` as an update message.
+  map_msgs::OccupancyGridUpdate updateOf(const mvog::CellRange& cells) const;
+  mvog::CellRange cells() const { return cells_; }
+
+ private:
+  void write(const mvog::CellRange& cells, const nav_msgs::OccupancyGrid::_data_type& values);
+
+  double z_;
+  Compute compute_;
+  nav_msgs::OccupancyGrid grid_;
+  mvog::CellRange cells_{{0, 0}, {-1, -1}};
+};
+
+}  // namespace mvog_ros
