@@ -1,13 +1,38 @@
 #include "mapper_config.h"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+
+#include <ros/names.h>
 
 namespace mvog_ros {
 namespace {
 
+// mvog::Map refuses grids of more cells than this (Map::crossSection, Map::projection).
+constexpr int kMaxGridCells = 1 << 28;
+
 void require(bool condition, const std::string& parameter, const std::string& reason) {
   if (!condition) throw mvog::ConfigError("~" + parameter + ": " + reason);
+}
+
+/// A period or timeout in seconds that ros::Duration can hold. `zero` says what 0 means, or is
+/// null if 0 is refused.
+void requireDuration(double seconds, const std::string& parameter, const char* zero) {
+  const double max_seconds = std::numeric_limits<std::int32_t>::max();
+  require((zero != nullptr ? seconds >= 0.0 : seconds > 0.0) && seconds <= max_seconds, parameter,
+          std::string("must be in ") + (zero != nullptr ? "[0, " : "(0, ") +
+              std::to_string(std::numeric_limits<std::int32_t>::max()) + "] s" +
+              (zero != nullptr ? std::string(" (0: ") + zero + ")" : ""));
+}
+
+/// A topic name: a valid ROS graph resource name.
+void requireTopics(const std::vector<std::string>& topics, const std::string& parameter) {
+  for (const std::string& topic : topics) {
+    std::string error;
+    require(ros::names::validate(topic, error) && !topic.empty(), parameter,
+            "'" + topic + "' is not a valid topic name" + (error.empty() ? "" : ": " + error));
+  }
 }
 
 /// Reads an optional parameter, checking its type: a value of another type is an error, not a
@@ -71,20 +96,21 @@ void MapperConfig::validate() const {
     if (message.rfind("num_threads", 0) == 0) message.replace(0, 11, "insertion_threads");
     throw mvog::ConfigError("~" + message);
   }
-  require(!frame_id.empty(), "frame_id", "must not be empty");
+  require(!frame_id.empty() && frame_id.front() != '/', "frame_id",
+          "must be a non-empty tf2 frame id (without a leading '/')");
+  requireTopics(scan_topics, "scan_topics");
+  requireTopics(cloud_topics, "cloud_topics");
   require(sensor_queue_size >= 1 && sensor_queue_size <= 1000, "sensor_queue_size",
           "must be in [1, 1000]");
   require(insertion_queue_size >= 1 && insertion_queue_size <= 1000, "insertion_queue_size",
           "must be in [1, 1000]");
-  require(std::isfinite(tf_timeout) && tf_timeout >= 0.0, "tf_timeout",
-          "must be a finite number >= 0");
+  requireDuration(tf_timeout, "tf_timeout", "no waiting");
   require(std::isfinite(voxel_filter_size) && voxel_filter_size >= 0.0, "voxel_filter_size",
           "must be a finite number >= 0 (0: off)");
   require(max_points_per_message >= 1, "max_points_per_message", "must be >= 1");
   require(std::isfinite(decay_factor) && decay_factor > 0.0 && decay_factor <= 1.0,
           "decay_factor", "must be in (0, 1]");
-  require(std::isfinite(decay_period) && decay_period >= 0.0, "decay_period",
-          "must be a finite number >= 0 (0: off)");
+  requireDuration(decay_period, "decay_period", "off");
   require(std::isfinite(occupancy_threshold) && occupancy_threshold >= 0.0 &&
               occupancy_threshold < 1.0,
           "occupancy_threshold", "must be in [0, 1)");
@@ -92,22 +118,20 @@ void MapperConfig::validate() const {
     require(std::isfinite(height) && std::fabs(height) <= map.max_coordinate,
             "cross_section_heights", "every height must be finite and within max_coordinate");
   }
-  require(!std::isnan(projection_min_z) && !std::isnan(projection_max_z) &&
-              projection_min_z <= projection_max_z,
-          "projection_min_z", "must not be NaN nor above ~projection_max_z");
-  require(std::isfinite(publish_period) && publish_period > 0.0, "publish_period",
-          "must be a finite number > 0");
-  require(std::isfinite(binary_map_period) && binary_map_period >= 0.0, "binary_map_period",
-          "must be a finite number >= 0 (0: off)");
-  require(std::isfinite(statistics_period) && statistics_period > 0.0, "statistics_period",
-          "must be a finite number > 0");
+  require(!std::isnan(projection_min_z), "projection_min_z", "must not be NaN");
+  require(!std::isnan(projection_max_z), "projection_max_z", "must not be NaN");
+  require(projection_min_z <= projection_max_z, "projection_min_z",
+          "must not be above ~projection_max_z");
+  requireDuration(publish_period, "publish_period", nullptr);
+  requireDuration(binary_map_period, "binary_map_period", "off");
+  requireDuration(statistics_period, "statistics_period", nullptr);
   require(!map_directory.empty(), "map_directory", "must not be empty");
-  require(std::isfinite(autosave_period) && autosave_period >= 0.0, "autosave_period",
-          "must be a finite number >= 0 (0: off)");
+  requireDuration(autosave_period, "autosave_period", "off");
   require(autosave_period == 0.0 || !autosave_file.empty(), "autosave_file",
           "must not be empty when ~autosave_period is set");
   require(max_query_points >= 1, "max_query_points", "must be >= 1");
-  require(max_cross_section_cells >= 1, "max_cross_section_cells", "must be >= 1");
+  require(max_cross_section_cells >= 1 && max_cross_section_cells <= kMaxGridCells,
+          "max_cross_section_cells", "must be in [1, 2^28]");
 }
 
 MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
