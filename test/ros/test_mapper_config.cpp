@@ -1,0 +1,227 @@
+// MapperConfig::validate (src/ros/mapper_config.h): every invalid parameter is refused with a
+// message naming it. (fromParameters needs a master: the rostests cover it.)
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "../../src/ros/mapper_config.h"
+
+namespace mvog_ros {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+MapperConfig validConfig() {
+  MapperConfig config;
+  config.map_directory = "/tmp/mvog_maps";  // fromParameters sets the default
+  return config;
+}
+
+/// The message validate() refuses `config` with, or "" if it accepts it.
+std::string refusal(const MapperConfig& config) {
+  try {
+    config.validate();
+  } catch (const mvog::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+struct InvalidCase {
+  std::string parameter;  // the parameter the message must name (without ~)
+  std::string what;
+  std::function<void(MapperConfig&)> change;
+};
+
+void expectRefused(const InvalidCase& invalid) {
+  MapperConfig config = validConfig();
+  invalid.change(config);
+  const std::string message = refusal(config);
+  EXPECT_EQ(message.rfind("~" + invalid.parameter + ":", 0), 0u)
+      << "~" << invalid.parameter << " " << invalid.what << ": got '" << message << "'";
+}
+
+TEST(MapperConfig, DefaultsAreValid) { EXPECT_EQ(refusal(validConfig()), ""); }
+
+TEST(MapperConfig, AcceptsSensibleNonDefaultValues) {
+  MapperConfig config = validConfig();
+  config.map.resolution = 0.05;
+  config.insertion.min_range = 0.3;
+  config.insertion.max_range = 8.0;
+  config.insertion.num_threads = 4;
+  config.scan_topics = {"front/scan", "/rear/scan", "~scan"};
+  config.cloud_topics = {"camera/depth/points"};
+  config.tf_timeout = 0.0;
+  config.voxel_filter_size = 0.05;
+  config.decay_factor = 0.9;
+  config.decay_period = 1.0;
+  config.occupancy_threshold = 0.0;
+  config.cross_section_heights = {-1.0, 0.5, 1.5};
+  config.projection_min_z = 0.1;
+  config.projection_max_z = 2.0;
+  config.binary_map_period = 0.0;
+  config.autosave_period = 60.0;
+  config.max_query_points = 1;
+  config.max_cross_section_cells = 1 << 28;
+  EXPECT_EQ(refusal(config), "");
+  config.projection_min_z = config.projection_max_z = 1.0;  // a single height
+  EXPECT_EQ(refusal(config), "");
+}
+
+/// Cases for a number that must be finite and > 0 (or >= 0 if `zero_allowed`).
+std::vector<InvalidCase> positiveNumberCases(const std::string& parameter,
+                                             const std::function<double&(MapperConfig&)>& field,
+                                             bool zero_allowed) {
+  std::vector<InvalidCase> cases;
+  std::vector<double> values = {kNaN, kInf, -kInf, -1.0, -1e-9};
+  if (!zero_allowed) values.push_back(0.0);
+  for (double value : values) {
+    cases.push_back({parameter, "= " + std::to_string(value),
+                     [field, value](MapperConfig& c) { field(c) = value; }});
+  }
+  return cases;
+}
+
+TEST(MapperConfig, RefusesNaNInfiniteNegativeOrZeroNumbers) {
+  std::vector<InvalidCase> cases;
+  auto add = [&](const std::string& parameter, const std::function<double&(MapperConfig&)>& field,
+                 bool zero_allowed) {
+    const std::vector<InvalidCase> more = positiveNumberCases(parameter, field, zero_allowed);
+    cases.insert(cases.end(), more.begin(), more.end());
+  };
+  add(
+      "resolution", [](MapperConfig& c) -> double& { return c.map.resolution; }, false);
+  add(
+      "max_coordinate", [](MapperConfig& c) -> double& { return c.map.max_coordinate; }, false);
+  add(
+      "min_range", [](MapperConfig& c) -> double& { return c.insertion.min_range; }, true);
+  add(
+      "tf_timeout", [](MapperConfig& c) -> double& { return c.tf_timeout; }, true);
+  add(
+      "voxel_filter_size", [](MapperConfig& c) -> double& { return c.voxel_filter_size; }, true);
+  add(
+      "decay_factor", [](MapperConfig& c) -> double& { return c.decay_factor; }, false);
+  add(
+      "decay_period", [](MapperConfig& c) -> double& { return c.decay_period; }, true);
+  add(
+      "publish_period", [](MapperConfig& c) -> double& { return c.publish_period; }, false);
+  add(
+      "binary_map_period", [](MapperConfig& c) -> double& { return c.binary_map_period; }, true);
+  add(
+      "statistics_period", [](MapperConfig& c) -> double& { return c.statistics_period; }, false);
+  add(
+      "autosave_period", [](MapperConfig& c) -> double& { return c.autosave_period; }, true);
+  for (const InvalidCase& invalid : cases) expectRefused(invalid);
+}
+
+TEST(MapperConfig, RefusesOutOfRangeValues) {
+  const std::vector<InvalidCase> cases = {
+      {"max_range", "NaN", [](MapperConfig& c) { c.insertion.max_range = kNaN; }},
+      {"max_range", "0", [](MapperConfig& c) { c.insertion.max_range = 0.0; }},
+      {"max_range", "< 0", [](MapperConfig& c) { c.insertion.max_range = -5.0; }},
+      {"max_coordinate", "over 2^22 cells",
+       [](MapperConfig& c) {
+         c.map.resolution = 0.001;
+         c.map.max_coordinate = 10000.0;
+       }},
+      {"insertion_threads", "0", [](MapperConfig& c) { c.insertion.num_threads = 0; }},
+      {"insertion_threads", "< 0", [](MapperConfig& c) { c.insertion.num_threads = -2; }},
+      {"insertion_threads", "1000", [](MapperConfig& c) { c.insertion.num_threads = 1000; }},
+      {"sensor_queue_size", "0", [](MapperConfig& c) { c.sensor_queue_size = 0; }},
+      {"sensor_queue_size", "< 0", [](MapperConfig& c) { c.sensor_queue_size = -1; }},
+      {"sensor_queue_size", "huge", [](MapperConfig& c) { c.sensor_queue_size = 1 << 30; }},
+      {"insertion_queue_size", "0", [](MapperConfig& c) { c.insertion_queue_size = 0; }},
+      {"insertion_queue_size", "< 0", [](MapperConfig& c) { c.insertion_queue_size = -1; }},
+      {"insertion_queue_size", "huge", [](MapperConfig& c) { c.insertion_queue_size = 1 << 30; }},
+      {"max_points_per_message", "0", [](MapperConfig& c) { c.max_points_per_message = 0; }},
+      {"max_points_per_message", "< 0", [](MapperConfig& c) { c.max_points_per_message = -1; }},
+      {"decay_factor", "> 1", [](MapperConfig& c) { c.decay_factor = 1.5; }},
+      {"occupancy_threshold", "NaN", [](MapperConfig& c) { c.occupancy_threshold = kNaN; }},
+      {"occupancy_threshold", "< 0", [](MapperConfig& c) { c.occupancy_threshold = -0.1; }},
+      {"occupancy_threshold", "1", [](MapperConfig& c) { c.occupancy_threshold = 1.0; }},
+      {"occupancy_threshold", "> 1", [](MapperConfig& c) { c.occupancy_threshold = 2.0; }},
+      {"max_query_points", "0", [](MapperConfig& c) { c.max_query_points = 0; }},
+      {"max_query_points", "< 0", [](MapperConfig& c) { c.max_query_points = -1; }},
+      {"max_cross_section_cells", "0", [](MapperConfig& c) { c.max_cross_section_cells = 0; }},
+      {"max_cross_section_cells", "< 0", [](MapperConfig& c) { c.max_cross_section_cells = -1; }},
+      {"max_cross_section_cells", "beyond the core's 2^28",
+       [](MapperConfig& c) { c.max_cross_section_cells = (1 << 28) + 1; }},
+      {"publish_period", "beyond ros::Duration", [](MapperConfig& c) { c.publish_period = 3e9; }},
+      {"statistics_period", "beyond ros::Duration",
+       [](MapperConfig& c) { c.statistics_period = 1e300; }},
+      {"tf_timeout", "beyond ros::Duration", [](MapperConfig& c) { c.tf_timeout = 1e10; }},
+      {"decay_period", "beyond ros::Duration", [](MapperConfig& c) { c.decay_period = 1e10; }},
+      {"binary_map_period", "beyond ros::Duration",
+       [](MapperConfig& c) { c.binary_map_period = 1e10; }},
+      {"autosave_period", "beyond ros::Duration",
+       [](MapperConfig& c) { c.autosave_period = 1e10; }},
+  };
+  for (const InvalidCase& invalid : cases) expectRefused(invalid);
+}
+
+TEST(MapperConfig, RefusesContradictoryValues) {
+  const std::vector<InvalidCase> cases = {
+      {"min_range", "= max_range",
+       [](MapperConfig& c) { c.insertion.min_range = c.insertion.max_range = 5.0; }},
+      {"min_range", "> max_range",
+       [](MapperConfig& c) {
+         c.insertion.min_range = 6.0;
+         c.insertion.max_range = 5.0;
+       }},
+      {"projection_min_z", "> projection_max_z",
+       [](MapperConfig& c) {
+         c.projection_min_z = 2.0;
+         c.projection_max_z = 1.0;
+       }},
+      {"projection_min_z", "NaN", [](MapperConfig& c) { c.projection_min_z = kNaN; }},
+      {"projection_max_z", "NaN", [](MapperConfig& c) { c.projection_max_z = kNaN; }},
+      {"projection_min_z", "above a max of -Inf",
+       [](MapperConfig& c) {
+         c.projection_min_z = 0.0;
+         c.projection_max_z = -kInf;
+       }},
+      {"cross_section_heights", "NaN",
+       [](MapperConfig& c) {
+         c.cross_section_heights = {0.5, kNaN};
+       }},
+      {"cross_section_heights", "Inf", [](MapperConfig& c) { c.cross_section_heights = {kInf}; }},
+      {"cross_section_heights", "beyond max_coordinate",
+       [](MapperConfig& c) { c.cross_section_heights = {c.map.max_coordinate + 1.0}; }},
+      {"autosave_file", "empty while autosaving",
+       [](MapperConfig& c) {
+         c.autosave_period = 10.0;
+         c.autosave_file.clear();
+       }},
+  };
+  for (const InvalidCase& invalid : cases) expectRefused(invalid);
+}
+
+TEST(MapperConfig, RefusesEmptyOrInvalidNames) {
+  const std::vector<InvalidCase> cases = {
+      {"frame_id", "empty", [](MapperConfig& c) { c.frame_id.clear(); }},
+      {"frame_id", "with a leading slash", [](MapperConfig& c) { c.frame_id = "/map"; }},
+      {"map_directory", "empty", [](MapperConfig& c) { c.map_directory.clear(); }},
+      {"scan_topics", "an empty topic",
+       [](MapperConfig& c) {
+         c.scan_topics = {"scan2", ""};
+       }},
+      {"scan_topics", "an invalid topic", [](MapperConfig& c) { c.scan_topics = {"bad topic"}; }},
+      {"cloud_topics", "an empty topic", [](MapperConfig& c) { c.cloud_topics = {""}; }},
+      {"cloud_topics", "an invalid topic", [](MapperConfig& c) { c.cloud_topics = {"3d/pts"}; }},
+  };
+  for (const InvalidCase& invalid : cases) expectRefused(invalid);
+}
+
+TEST(MapperConfig, AnEmptyAutosaveFileIsFineWhileAutosaveIsOff) {
+  MapperConfig config = validConfig();
+  config.autosave_file.clear();
+  EXPECT_EQ(refusal(config), "");
+}
+
+}  // namespace
+}  // namespace mvog_ros
