@@ -1,0 +1,38 @@
+#include "input.h"
+
+#include <fstream>
+
+namespace mvog_bench {
+
+std::size_t InputData::readings() const {
+  std::size_t total = 0;
+  for (const mvog::Scan& scan : scans) total += scan.hits.size();
+  return total;
+}
+
+InputData loadInput(const std::string& path, const std::string& fixed_frame) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(path + ": cannot open the file (missing or unreadable)");
+  static const std::string kBagMagic = "#ROSBAG V2.0\n";
+  std::string head(kBagMagic.size(), '\0');
+  file.read(&head[0], static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(file.gcount()));
+  file.close();
+  InputData input;
+  if (head == kBagMagic) {
+    input = loadBag(path, fixed_frame);
+  } else if (path.size() >= 6 && path.compare(path.size() - 6, 6, ".graph") == 0) {
+    input = loadScanGraph(path);
+  } else {
+    throw InputError(path + ": neither a ROS bag (format 2.0) nor an OctoMap ScanGraph (.graph)");
+  }
+  if (input.readings() == 0) {
+    throw InputError(path + ": no obstacle readings to insert (" +
+                     std::to_string(input.sensor_messages) + " sensor messages, " +
+                     std::to_string(input.without_transform) + " without a transform, " +
+                     std::to_string(input.invalid_messages) + " malformed)");
+  }
+  return input;
+}
+
+}  // namespace mvog_bench

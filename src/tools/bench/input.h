@@ -1,0 +1,50 @@
+#pragma once
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mvog/map.h"
+
+namespace mvog_bench {
+
+/// An input file that cannot be used; the message says what is wrong.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Every scan of an input file, read into memory before anything is timed.
+///
+/// Both backends see exactly these rays: each scan's origin and its obstacle readings (hits) in
+/// the map frame, single precision. Out-of-range readings are counted but disregarded, as in the
+/// paper's Table I ("Out-of-range sensor readings present in the experiments are disregarded in
+/// all four representations"), so `Scan::free_endpoints` is always empty.
+struct InputData {
+  std::string format;  ///< "bag" or "graph"
+  std::vector<mvog::Scan> scans;
+  std::size_t sensor_messages = 0;        ///< LaserScan/PointCloud2 messages or graph nodes
+  std::size_t without_transform = 0;      ///< messages skipped: no transform to the fixed frame
+  std::size_t invalid_messages = 0;       ///< messages skipped: malformed
+  std::size_t out_of_range_readings = 0;  ///< +Inf / beyond range_max: disregarded
+  std::size_t skipped_beams = 0;          ///< NaN, -Inf or below range_min: no information
+  std::size_t non_finite_points = 0;      ///< cloud points with a NaN or infinite coordinate
+
+  /// Obstacle readings over all scans.
+  std::size_t readings() const;
+};
+
+/// Reads a ROS bag (by its "#ROSBAG V2.0" header) or an OctoMap ScanGraph (.graph).
+/// Throws InputError for a missing, unreadable, truncated or unusable file.
+InputData loadInput(const std::string& path, const std::string& fixed_frame);
+
+/// Every LaserScan and PointCloud2 of the bag, with each message's pose looked up in a tf2 buffer
+/// holding every /tf and /tf_static message of the bag.
+InputData loadBag(const std::string& path, const std::string& fixed_frame);
+
+/// Every node of an OctoMap ScanGraph binary file, parsed with every count checked against the
+/// file size first (a truncated or corrupt file is an error, never a partial graph).
+InputData loadScanGraph(const std::string& path);
+
+}  // namespace mvog_bench

@@ -1,0 +1,309 @@
+#include "report.h"
+
+#include <unistd.h>
+
+#include <cinttypes>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+#include <utility>
+
+namespace mvog_bench {
+namespace {
+
+constexpr std::size_t kPointCloudBytesPerPoint = 12;  // Table I: 3 single-precision floats
+constexpr std::size_t kVoxelBytes = 4;                // Table I: one single-precision float
+
+const char* const kStateNames[] = {"unknown", "free", "occupied"};
+
+double perSecond(std::size_t readings, double seconds) {
+  return seconds > 0.0 ? static_cast<double>(readings) / seconds : 0.0;
+}
+
+double ratio(double numerator, double denominator) {
+  return denominator > 0.0 ? numerator / denominator : std::nan("");
+}
+
+std::string hex(std::uint64_t value) {
+  char text[19];
+  std::snprintf(text, sizeof(text), "%016" PRIx64, value);
+  return text;
+}
+
+/// A JSON object built key by key, rendered on one line (values are rendered when added).
+class JsonObject {
+ public:
+  JsonObject& add(const std::string& key, double value) {
+    if (!std::isfinite(value)) return raw(key, "null");
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.9g", value);
+    return raw(key, text);
+  }
+  JsonObject& add(const std::string& key, std::size_t value) {
+    return raw(key, std::to_string(value));
+  }
+  JsonObject& add(const std::string& key, int value) { return raw(key, std::to_string(value)); }
+  JsonObject& add(const std::string& key, const std::string& value) {
+    return raw(key, quote(value));
+  }
+  JsonObject& add(const std::string& key, const char* value) { return raw(key, quote(value)); }
+  JsonObject& add(const std::string& key, const JsonObject& value) { return raw(key, value.str()); }
+  /// An array of objects, one per line, indented for a top-level object.
+  JsonObject& add(const std::string& key, const std::vector<JsonObject>& values) {
+    std::string text = "[";
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      text += (k == 0 ? "\n    " : ",\n    ") + values[k].str();
+    }
+    return raw(key, text + (values.empty() ? "]" : "\n  ]"));
+  }
+  JsonObject& raw(const std::string& key, const std::string& json) {
+    entries_.emplace_back(key, json);
+    return *this;
+  }
+  /// On one line.
+  std::string str() const { return render("{", ", ", "}"); }
+  /// One key per line, for a top-level object.
+  std::string pretty() const { return render("{\n  ", ",\n  ", "\n}\n"); }
+
+ private:
+  static std::string quote(const std::string& text) {
+    std::string quoted = "\"";
+    for (const char c : text) {
+      if (c == '"' || c == '\\') {
+        quoted += '\\';
+        quoted += c;
+      } else if (static_cast<unsigned char>(c) < 0x20) {
+        char escaped[7];
+        std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
+        quoted += escaped;
+      } else {
+        quoted += c;
+      }
+    }
+    return quoted + "\"";
+  }
+
+  std::string render(const char* open, const char* separator, const char* close) const {
+    std::string text = open;
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      text += (k == 0 ? "" : separator) + quote(entries_[k].first) + ": " + entries_[k].second;
+    }
+    return text + close;
+  }
+
+  std::vector<std::pair<std::string, std::string>> entries_;
+};
+
+JsonObject mvogJson(double resolution, std::size_t readings, const MvogStats& s) {
+  JsonObject o;
+  o.add("backend", "mvog")
+      .add("resolution", resolution)
+      .add("readings", readings)
+      .add("insert_seconds", s.insert_seconds)
+      .add("readings_per_second", perSecond(readings, s.insert_seconds))
+      .add("memory_bytes", s.memory.bytes_held)
+      .add("file_bytes", s.file_bytes)
+      .add("threads", s.threads)
+      .add("table_one_bytes", s.memory.table_one_bytes)
+      .add("minimal_grid_cells", s.memory.minimal_grid_cells)
+      .add("cells_with_volumes", s.memory.cells_with_volumes)
+      .add("positive_volumes", s.memory.positive_volumes)
+      .add("negative_volumes", s.memory.negative_volumes)
+      .add("tiles", s.memory.tiles)
+      .add("obstacle_readings", s.insertion.obstacle_readings)
+      .add("truncated_to_max_range", s.insertion.truncated_to_max_range)
+      .add("rejected_readings", s.insertion.rejected())
+      .add("map_checksum", hex(s.checksum));
+  return o;
+}
+
+JsonObject octomapJson(double resolution, std::size_t readings, const OctomapStats& s) {
+  JsonObject o;
+  o.add("backend", "octomap")
+      .add("resolution", resolution)
+      .add("readings", readings)
+      .add("insert_seconds", s.insert_seconds)
+      .add("readings_per_second", perSecond(readings, s.insert_seconds))
+      .add("memory_bytes", s.memory_bytes)
+      .add("file_bytes", s.binary_file_bytes)
+      .add("threads", 1)
+      .add("full_file_bytes", s.full_file_bytes)
+      .add("tree_nodes", s.tree_nodes)
+      .add("leaf_nodes", s.leaf_nodes);
+  return o;
+}
+
+JsonObject agreementJson(const StateAgreement& a) {
+  std::string matrix = "{";
+  for (std::size_t m = 0; m < 3; ++m) {
+    matrix += std::string(m == 0 ? "" : ", ") + "\"" + kStateNames[m] + "\": {";
+    for (std::size_t o = 0; o < 3; ++o) {
+      matrix += std::string(o == 0 ? "" : ", ") + "\"" + kStateNames[o] +
+                "\": " + std::to_string(a.counts[m][o]);
+    }
+    matrix += "}";
+  }
+  JsonObject o;
+  o.add("points", a.points())
+      .add("agreeing", a.agreeing())
+      .add("fraction", ratio(static_cast<double>(a.agreeing()), static_cast<double>(a.points())))
+      .raw("mvog_vs_octomap", matrix + "}");
+  return o;
+}
+
+std::string megabytes(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3f MB", bytes / 1e6);
+  return text;
+}
+
+std::string optionalMegabytes(bool present, std::size_t bytes) {
+  return present ? megabytes(static_cast<double>(bytes)) : "-";
+}
+
+std::string percent(const StateAgreement& a) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f %%",
+                100.0 * ratio(static_cast<double>(a.agreeing()), static_cast<double>(a.points())));
+  return text;
+}
+
+}  // namespace
+
+void printReport(const BenchReport& report, const InputData& input, std::FILE* out) {
+  const std::size_t readings = input.readings();
+  std::fprintf(out, "input       %s (%s), loaded in %.2f s\n", report.input_path.c_str(),
+               input.format.c_str(), report.load_seconds);
+  std::fprintf(out,
+               "readings    %zu obstacle readings in %zu scans (of %zu sensor messages); "
+               "disregarded: %zu out-of-range, %zu invalid beams, %zu non-finite points; "
+               "skipped messages: %zu without transform, %zu malformed\n",
+               readings, input.scans.size(), input.sensor_messages, input.out_of_range_readings,
+               input.skipped_beams, input.non_finite_points, input.without_transform,
+               input.invalid_messages);
+  if (std::isfinite(report.max_range)) {
+    std::fprintf(out, "max range   %.2f m\n\n", report.max_range);
+  } else {
+    std::fprintf(out, "max range   none\n\n");
+  }
+
+  std::fprintf(out, "%-8s %7s %7s %10s %10s %12s %14s %14s %14s\n", "backend", "res (m)", "threads",
+               "readings", "insert (s)", "readings/s", "memory (B)", "file (B)", ".ot file (B)");
+  for (const ResolutionReport& r : report.resolutions) {
+    if (r.mvog) {
+      std::fprintf(out, "%-8s %7.3f %7d %10zu %10.3f %12.0f %14zu %14zu %14s\n", "mvog",
+                   r.resolution, r.mvog->threads, readings, r.mvog->insert_seconds,
+                   perSecond(readings, r.mvog->insert_seconds), r.mvog->memory.bytes_held,
+                   r.mvog->file_bytes, "-");
+    }
+    if (r.octomap) {
+      std::fprintf(out, "%-8s %7.3f %7d %10zu %10.3f %12.0f %14zu %14zu %14zu\n", "octomap",
+                   r.resolution, 1, readings, r.octomap->insert_seconds,
+                   perSecond(readings, r.octomap->insert_seconds), r.octomap->memory_bytes,
+                   r.octomap->binary_file_bytes, r.octomap->full_file_bytes);
+    }
+  }
+
+  std::fprintf(out, "\nTable I (single precision; out-of-range readings disregarded)\n");
+  std::fprintf(out, "%7s %14s %14s %14s %14s\n", "res (m)", "point cloud", "voxel grid", "OctoMap",
+               "MVOG");
+  for (const ResolutionReport& r : report.resolutions) {
+    std::fprintf(
+        out, "%7.3f %14s %14s %14s %14s\n", r.resolution,
+        megabytes(static_cast<double>(readings * kPointCloudBytesPerPoint)).c_str(),
+        megabytes(static_cast<double>(r.voxel_grid_cells) * kVoxelBytes).c_str(),
+        optionalMegabytes(r.octomap.has_value(), r.octomap ? r.octomap->memory_bytes : 0).c_str(),
+        optionalMegabytes(r.mvog.has_value(), r.mvog ? r.mvog->memory.table_one_bytes : 0).c_str());
+  }
+
+  bool header = false;
+  for (const ResolutionReport& r : report.resolutions) {
+    if (!r.mvog || !r.octomap) continue;
+    if (!header) {
+      std::fprintf(out, "\nMVOG / OctoMap\n%7s %12s %14s %14s %12s   %s\n", "res (m)", "readings/s",
+                   "memory held", "Table I", "file",
+                   "agreement: endpoints, along rays (sampled rays)");
+      header = true;
+    }
+    std::fprintf(out, "%7.3f %11.2fx %13.3fx %13.3fx %11.3fx   %s, %s (%zu)\n", r.resolution,
+                 ratio(r.octomap->insert_seconds, r.mvog->insert_seconds),
+                 ratio(static_cast<double>(r.mvog->memory.bytes_held),
+                       static_cast<double>(r.octomap->memory_bytes)),
+                 ratio(static_cast<double>(r.mvog->memory.table_one_bytes),
+                       static_cast<double>(r.octomap->memory_bytes)),
+                 ratio(static_cast<double>(r.mvog->file_bytes),
+                       static_cast<double>(r.octomap->binary_file_bytes)),
+                 percent(r.agreement->endpoints).c_str(), percent(r.agreement->along_rays).c_str(),
+                 r.agreement->sampled_rays);
+  }
+}
+
+void writeJson(const BenchReport& report, const InputData& input, const std::string& path) {
+  const std::size_t readings = input.readings();
+  std::vector<JsonObject> results, table_one, comparison, agreement;
+  for (const ResolutionReport& r : report.resolutions) {
+    if (r.mvog) results.push_back(mvogJson(r.resolution, readings, *r.mvog));
+    if (r.octomap) results.push_back(octomapJson(r.resolution, readings, *r.octomap));
+    JsonObject row;
+    row.add("resolution", r.resolution)
+        .add("point_cloud_bytes", readings * kPointCloudBytesPerPoint)
+        .add("voxel_grid_cells", r.voxel_grid_cells)
+        .add("voxel_grid_bytes", r.voxel_grid_cells * kVoxelBytes);
+    if (r.octomap) row.add("octomap_bytes", r.octomap->memory_bytes);
+    if (r.mvog) row.add("mvog_bytes", r.mvog->memory.table_one_bytes);
+    table_one.push_back(row);
+    if (!r.mvog || !r.octomap) continue;
+    JsonObject ratios;
+    ratios.add("resolution", r.resolution)
+        .add("readings_per_second_ratio", ratio(r.octomap->insert_seconds, r.mvog->insert_seconds))
+        .add("memory_ratio", ratio(static_cast<double>(r.mvog->memory.bytes_held),
+                                   static_cast<double>(r.octomap->memory_bytes)))
+        .add("table_one_ratio", ratio(static_cast<double>(r.mvog->memory.table_one_bytes),
+                                      static_cast<double>(r.octomap->memory_bytes)))
+        .add("file_ratio", ratio(static_cast<double>(r.mvog->file_bytes),
+                                 static_cast<double>(r.octomap->binary_file_bytes)));
+    comparison.push_back(ratios);
+    JsonObject sampled;
+    sampled.add("resolution", r.resolution)
+        .add("sampled_rays", r.agreement->sampled_rays)
+        .add("endpoints", agreementJson(r.agreement->endpoints))
+        .add("along_rays", agreementJson(r.agreement->along_rays));
+    agreement.push_back(sampled);
+  }
+  JsonObject input_json;
+  input_json.add("path", report.input_path)
+      .add("format", input.format)
+      .add("sensor_messages", input.sensor_messages)
+      .add("scans", input.scans.size())
+      .add("readings", readings)
+      .add("out_of_range_disregarded", input.out_of_range_readings)
+      .add("invalid_beams", input.skipped_beams)
+      .add("non_finite_points", input.non_finite_points)
+      .add("messages_without_transform", input.without_transform)
+      .add("malformed_messages", input.invalid_messages)
+      .add("load_seconds", report.load_seconds);
+  JsonObject document;
+  document.add("results", results)
+      .add("input", input_json)
+      .add("max_range", report.max_range)
+      .add("table_one", table_one)
+      .add("comparison", comparison)
+      .add("agreement", agreement);
+
+  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream file(temporary, std::ios::trunc);
+    file << document.pretty();
+    file.close();
+    if (!file) {
+      std::remove(temporary.c_str());
+      throw std::runtime_error(path + ": cannot write the JSON report");
+    }
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    std::remove(temporary.c_str());
+    throw std::runtime_error(path + ": cannot rename the JSON report into place");
+  }
+}
+
+}  // namespace mvog_bench

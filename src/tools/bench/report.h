@@ -1,0 +1,38 @@
+#pragma once
+
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "backends.h"
+#include "input.h"
+
+namespace mvog_bench {
+
+/// Everything measured at one resolution; a backend not run is empty.
+struct ResolutionReport {
+  double resolution = 0.0;
+  std::size_t voxel_grid_cells = 0;  ///< boundingBoxVoxels()
+  std::optional<MvogStats> mvog;
+  std::optional<OctomapStats> octomap;
+  std::optional<Agreement> agreement;  ///< when both backends ran
+};
+
+struct BenchReport {
+  std::string input_path;
+  double load_seconds = 0.0;
+  double max_range = 0.0;  ///< infinity: none
+  std::vector<ResolutionReport> resolutions;
+};
+
+/// The readable tables: per backend and resolution, Table I, MVOG / OctoMap ratios, agreement.
+void printReport(const BenchReport& report, const InputData& input, std::FILE* out);
+
+/// {"results": [{"backend", "resolution", "readings", "insert_seconds", "readings_per_second",
+/// "memory_bytes", "file_bytes", ...}, ...], "input": {...}, "table_one": [...],
+/// "comparison": [...], "agreement": [...]}, written atomically (temporary file, then rename).
+/// Throws std::runtime_error if it cannot be written.
+void writeJson(const BenchReport& report, const InputData& input, const std::string& path);
+
+}  // namespace mvog_bench

@@ -1,0 +1,162 @@
+// Smoke test of mvog_bench: behaviour only (never timings). Runs the executable on
+// spherical_scan.graph from the shared data (MVOG_DATA_DIR, default ../shared/data beside the
+// repository; skipped when absent unless CI=true), on scan graphs it writes itself, and on bad
+// input.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <json/json.h>
+
+namespace {
+
+class BenchSmokeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char pattern[] = "/tmp/mvog_bench_test_XXXXXX";
+    ASSERT_NE(::mkdtemp(pattern), nullptr);
+    directory_ = pattern;
+  }
+  void TearDown() override {
+    const std::string command = "rm -rf '" + directory_ + "'";
+    EXPECT_EQ(std::system(command.c_str()), 0);
+  }
+
+  /// Runs mvog_bench with `arguments`; returns its exit code, its stderr in `errors`.
+  int runBench(const std::string& arguments, std::string& errors) const {
+    const std::string error_file = directory_ + "/stderr.txt";
+    const std::string command = std::string("'") + MVOG_BENCH_EXECUTABLE + "' " + arguments +
+                                " > /dev/null 2> '" + error_file + "'";
+    const int status = std::system(command.c_str());
+    std::ifstream file(error_file);
+    std::stringstream text;
+    text << file.rdbuf();
+    errors = text.str();
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  Json::Value readJson(const std::string& path) const {
+    std::ifstream file(path);
+    Json::Value root;
+    Json::CharReaderBuilder builder;
+    std::string errors;
+    EXPECT_TRUE(Json::parseFromStream(builder, file, &root, &errors)) << errors;
+    return root;
+  }
+
+  /// Writes a ScanGraph: one node per entry of `nodes` (points in the sensor frame), pose
+  /// translation (0, 0, 1) and identity rotation, no edges; `cut` bytes are left off the end.
+  std::string writeGraph(const std::string& name, const std::vector<std::vector<double>>& nodes,
+                         std::size_t cut = 0) const {
+    std::string bytes;
+    auto u32 = [&](std::uint32_t v) { bytes.append(reinterpret_cast<const char*>(&v), 4); };
+    auto f64 = [&](double v) { bytes.append(reinterpret_cast<const char*>(&v), 8); };
+    u32(static_cast<std::uint32_t>(nodes.size()));
+    for (std::size_t n = 0; n < nodes.size(); ++n) {
+      u32(static_cast<std::uint32_t>(nodes[n].size() / 3));
+      for (std::size_t k = 0; k < nodes[n].size(); k += 3) {
+        u32(3);
+        for (int axis = 0; axis < 3; ++axis) f64(nodes[n][k + axis]);
+      }
+      u32(3);
+      for (double t : {0.0, 0.0, 1.0}) f64(t);
+      u32(4);
+      for (double q : {1.0, 0.0, 0.0, 0.0}) f64(q);
+      u32(static_cast<std::uint32_t>(n));
+    }
+    u32(0);  // edges
+    bytes.resize(bytes.size() - cut);
+    const std::string path = directory_ + "/" + name;
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+  }
+
+  std::string directory_;
+};
+
+std::string dataDirectory() {
+  const char* from_environment = std::getenv("MVOG_DATA_DIR");
+  if (from_environment != nullptr && from_environment[0] != '\0') return from_environment;
+  return std::string(MVOG_SOURCE_DIR) + "/../shared/data";
+}
+
+bool inCi() {
+  const char* ci = std::getenv("CI");
+  return ci != nullptr && std::strcmp(ci, "true") == 0;
+}
+
+TEST_F(BenchSmokeTest, BothBackendsMapTheSphericalScan) {
+  const std::string input = dataDirectory() + "/spherical_scan.graph";
+  if (!std::ifstream(input)) {
+    if (inCi()) FAIL() << input << " is missing (set MVOG_DATA_DIR to the shared data)";
+    GTEST_SKIP() << input << " is missing: set MVOG_DATA_DIR to the shared data directory";
+  }
+  const std::string json = directory_ + "/x.json";
+  std::string errors;
+  ASSERT_EQ(
+      runBench("--input '" + input + "' --resolution 0.1 --backend both --json '" + json + "'",
+               errors),
+      0)
+      << errors;
+  const Json::Value root = readJson(json);
+  std::set<std::string> backends;
+  for (const Json::Value& result : root["results"]) {
+    backends.insert(result["backend"].asString());
+    EXPECT_EQ(result["resolution"].asDouble(), 0.1);
+    EXPECT_EQ(result["readings"].asUInt64(), 10201u);  // the fixture's point count
+    EXPECT_GT(result["memory_bytes"].asUInt64(), 0u);
+    EXPECT_GT(result["file_bytes"].asUInt64(), 0u);
+  }
+  EXPECT_EQ(backends, (std::set<std::string>{"mvog", "octomap"}));
+  ASSERT_EQ(root["agreement"].size(), 1u);
+  EXPECT_GT(root["agreement"][0]["endpoints"]["points"].asUInt64(), 0u);
+  ASSERT_EQ(root["table_one"].size(), 1u);
+  EXPECT_EQ(root["table_one"][0]["point_cloud_bytes"].asUInt64(), 12u * 10201u);
+}
+
+TEST_F(BenchSmokeTest, ReadsEveryNodeOfAGraphItWrote) {
+  const std::string input =
+      writeGraph("two.graph", {{2, 0, 0, 0, 2, 0, -2, 0, 0}, {0, -2, 0.5, 1.5, 1.5, 0}});
+  const std::string json = directory_ + "/two.json";
+  std::string errors;
+  ASSERT_EQ(runBench("--input '" + input + "' --resolution 0.1 --resolution 0.2 --threads 2 " +
+                         "--json '" + json + "'",
+                     errors),
+            0)
+      << errors;
+  const Json::Value root = readJson(json);
+  ASSERT_EQ(root["results"].size(), 4u);  // two resolutions, both backends by default
+  for (const Json::Value& result : root["results"]) {
+    EXPECT_EQ(result["readings"].asUInt64(), 5u);
+  }
+  EXPECT_EQ(root["input"]["scans"].asUInt64(), 2u);
+}
+
+TEST_F(BenchSmokeTest, RefusesBadInputWithAMessage) {
+  std::string errors;
+  EXPECT_NE(runBench("--input '" + directory_ + "/missing.bag'", errors), 0);
+  EXPECT_NE(errors.find("cannot open"), std::string::npos) << errors;
+
+  const std::string truncated = writeGraph("cut.graph", {{2, 0, 0, 0, 2, 0}}, 30);
+  EXPECT_NE(runBench("--input '" + truncated + "'", errors), 0);
+  EXPECT_NE(errors.find("truncated"), std::string::npos) << errors;
+
+  const std::string not_a_bag = directory_ + "/notes.bag";
+  std::ofstream(not_a_bag) << "not a bag\n";
+  EXPECT_NE(runBench("--input '" + not_a_bag + "'", errors), 0);
+  EXPECT_NE(errors.find("neither a ROS bag"), std::string::npos) << errors;
+
+  EXPECT_EQ(runBench("--input x --backend nothing", errors), 2);
+}
+
+}  // namespace
