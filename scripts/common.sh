@@ -12,10 +12,11 @@ export MVOG_DATA_DIR=${MVOG_DATA_DIR:-$(cd "$REPO/.." && pwd)/shared/data}
 MVOG_PACKAGES=(
   build-essential cmake libeigen3-dev libgtest-dev libbenchmark-dev
   ros-core-python-dev ros-base-dev python3-rostest rosbash python3-rosbag python3-numpy
+  python3-rospy python3-sensor-msgs python3-geometry-msgs python3-tf2-msgs python3-tf2-ros
   libpcl-ros-dev libpcl-conversions-dev libtf2-ros-dev libtf2-sensor-msgs-dev libtf2-eigen-dev
   libtf2-geometry-msgs-dev liblaser-geometry-dev libstd-srvs-dev libvisualization-msgs-dev
   libnav-msgs-dev libmap-msgs-dev libdiagnostic-msgs-dev rviz tf2-tools liboctomap-dev octomap-tools
-  xvfb xauth libgl1-mesa-dri imagemagick
+  xvfb xauth x11-utils libgl1-mesa-dri imagemagick
 )
 
 as_root() {
@@ -47,12 +48,11 @@ install_missing_packages() {
     --no-install-recommends "${missing[@]}"
 }
 
-# The catkin workspace links the repository as its only package.
+# The catkin workspace links the repository as its only package. Arguments go to catkin_make.
 build_workspace() {
   mkdir -p "$WORKSPACE/src"
   ln -sfn "$REPO" "$WORKSPACE/src/mvog"
-  quietly catkin_make bash -c "cd '$WORKSPACE' && catkin_make -DCMAKE_BUILD_TYPE=Release \
-    -DCATKIN_ENABLE_TESTING=ON -j2 $*"
+  (cd "$WORKSPACE" && quietly catkin_make catkin_make -DCMAKE_BUILD_TYPE=Release -j2 "$@")
 }
 
 source_workspace() {

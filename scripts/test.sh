@@ -26,7 +26,7 @@ passed=$((passed + ${core_total:-0} - ${core_failed:-0}))
 failed=$((failed + ${core_failed:-1}))
 
 # 2. The catkin package: gtests and rostests.
-build_workspace
+build_workspace -DCATKIN_ENABLE_TESTING=ON
 source_workspace
 rm -rf "$WORKSPACE/build/test_results"
 quietly run-tests bash -c "cd '$WORKSPACE' && catkin_make run_tests -j2" || true

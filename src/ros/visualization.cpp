@@ -19,9 +19,9 @@ std_msgs::ColorRGBA colour(float r, float g, float b, float a) {
   return c;
 }
 
-/// Height colour map (blue, low, through green to red, high), cycling every `period` metres.
-std_msgs::ColorRGBA heightColour(double z, double period) {
-  const double h = std::fmod(std::fmod(z / period, 1.0) + 1.0, 1.0) * 4.0;  // 0..4
+/// Height colour map: blue at z <= 0 through cyan, green and yellow to red at z >= top.
+std_msgs::ColorRGBA heightColour(double z, double top) {
+  const double h = std::clamp(z / top, 0.0, 0.999) * 4.0;  // 0..4
   const auto f = static_cast<float>(h - std::floor(h));
   switch (static_cast<int>(h)) {
     case 0: return colour(0, f, 1, 1);
