@@ -1,0 +1,496 @@
+// Insertion of readings and scans (Sec. III-B): eqs. (3)-(6) on the rays of Fig. 3, the
+// InsertionConfig options, scan insertion with threads, the Sec. V.B option, and the Sec. III-A
+// invariants after many random readings.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "mvog/map.h"
+#include "test_util.h"
+
+namespace mvog {
+namespace {
+
+using test::allVolumes;
+using test::totalMass;
+using test::unitConfig;
+using test::volumeIs;
+
+// ---- Fig. 3 (s = 1, so heights in grid units are metres) --------------------------------------
+
+TEST(Insertion, Fig3LeftRayHasPaddingVolume) {
+  Map map(unitConfig());
+  const InsertionResult result = map.insertReading({0, 0, 0}, {0, 4.5, 10}, true);
+  EXPECT_EQ(result.obstacle_readings, 1u);
+  // x = 0 lies in cell i = 0. The projection runs along +y from 0 to 4.5 through cells
+  // j = 0..4; the ray rises z = (10 / 4.5) y, so it crosses the wall y = j at z = 2.222 j.
+  const double slope = 10.0 / 4.5;
+  for (int j = 0; j < 4; ++j) {
+    SCOPED_TRACE(::testing::Message() << "cell (0, " << j << ")");
+    // Eq. (3): [z_enter, z_exit] = [2.222 j, 2.222 (j + 1)]; the height 2.222 >= 1, so eq. (6)
+    // leaves it, and at density 1 its mass is its height.
+    const CellVolumes cell = map.cellVolumes({0, j});
+    EXPECT_TRUE(cell.positive.empty());
+    ASSERT_EQ(cell.negative.size(), 1u);
+    EXPECT_TRUE(volumeIs(cell.negative[0], slope * j, slope * (j + 1), slope));
+  }
+  // Last cell j = 4: z_enter = 2.222 * 4 = 8.889 and L'_z = 10, |z_enter - L'_z| = 1.111 > 1.
+  // Eq. (5): V = [10 - 0.5, 10 + 0.5] = [9.5, 10.5], mass 1.
+  // The padding V' spans z_enter to V's bottom: [8.889, 9.5], height 0.611 < 1, so eq. (6)
+  // centres it on (8.889 + 9.5) / 2 = 9.194: [8.694, 9.694], mass 1.
+  const CellVolumes last = map.cellVolumes({0, 4});
+  ASSERT_EQ(last.positive.size(), 1u);
+  EXPECT_TRUE(volumeIs(last.positive[0], 9.5, 10.5, 1.0));
+  ASSERT_EQ(last.negative.size(), 1u);
+  const double pad_centre = 0.5 * (4 * slope + 9.5);
+  EXPECT_TRUE(volumeIs(last.negative[0], pad_centre - 0.5, pad_centre + 0.5, 1.0));
+  EXPECT_EQ(test::observedCells(map).size(), 5u);
+  EXPECT_EQ(allVolumes(map).size(), 6u);
+}
+
+TEST(Insertion, Fig3RightRayHasNoPaddingVolume) {
+  Map map(unitConfig());
+  map.insertReading({0, 0, 0}, {0, 10.5, 4}, true);
+  // Cells j = 0..10 along +y; z = (4 / 10.5) y crosses the wall y = j at z = 0.381 j.
+  const double slope = 4.0 / 10.5;
+  for (int j = 0; j < 10; ++j) {
+    SCOPED_TRACE(::testing::Message() << "cell (0, " << j << ")");
+    // Eq. (3): [0.381 j, 0.381 (j + 1)] has height 0.381 < 1; eq. (6) centres it on
+    // 0.381 (j + 0.5) with height 1 and mass 1.
+    const CellVolumes cell = map.cellVolumes({0, j});
+    EXPECT_TRUE(cell.positive.empty());
+    ASSERT_EQ(cell.negative.size(), 1u);
+    const double centre = slope * (j + 0.5);
+    EXPECT_TRUE(volumeIs(cell.negative[0], centre - 0.5, centre + 0.5, 1.0));
+  }
+  // Last cell j = 10: z_enter = 3.810, L'_z = 4, |z_enter - L'_z| = 0.190 <= 1: only V of eq. (5),
+  // [3.5, 4.5] with mass 1, and no negative volume.
+  const CellVolumes last = map.cellVolumes({0, 10});
+  ASSERT_EQ(last.positive.size(), 1u);
+  EXPECT_TRUE(volumeIs(last.positive[0], 3.5, 4.5, 1.0));
+  EXPECT_TRUE(last.negative.empty());
+  EXPECT_EQ(test::observedCells(map).size(), 11u);
+}
+
+TEST(Insertion, Fig3LeftRayAsOutOfRangeReadingIsFreeUpToItsEnd) {
+  Map map(unitConfig());
+  const InsertionResult result = map.insertReading({0, 0, 0}, {0, 4.5, 10}, false);
+  EXPECT_EQ(result.out_of_range_readings, 1u);
+  EXPECT_EQ(result.obstacle_readings, 0u);
+  // Cells j = 0..3 as for the obstacle reading; the last cell gets eq. (4):
+  // [min(z_enter, L'_z), max(z_enter, L'_z)] = [8.889, 10], mass 1.111, and no positive volume.
+  const double slope = 10.0 / 4.5;
+  for (int j = 0; j < 4; ++j) {
+    const CellVolumes cell = map.cellVolumes({0, j});
+    ASSERT_EQ(cell.negative.size(), 1u);
+    EXPECT_TRUE(volumeIs(cell.negative[0], slope * j, slope * (j + 1), slope));
+  }
+  const CellVolumes last = map.cellVolumes({0, 4});
+  EXPECT_TRUE(last.positive.empty());
+  ASSERT_EQ(last.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(last.negative[0], 4 * slope, 10.0, 10.0 - 4 * slope));
+  map.forEachVolume([](const CellIndex&, VolumeSign sign, const Volume&) {
+    EXPECT_EQ(sign, VolumeSign::kNegative);
+  });
+}
+
+// ---- Eq. (5), both cases, in both directions -------------------------------------------------
+
+TEST(Insertion, DescendingRayPadsDownToTheObstacleTop) {
+  Map map(unitConfig());
+  map.insertReading({0.5, 0.5, 10}, {1.5, 0.5, 0}, true);
+  // Cell (0, 0): z from 10 down to 5 at the wall x = 1: eq. (3) gives [5, 10], mass 5.
+  const CellVolumes first = map.cellVolumes({0, 0});
+  ASSERT_EQ(first.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(first.negative[0], 5.0, 10.0, 5.0));
+  // Cell (1, 0): z_enter = 5, L'_z = 0, |5 - 0| > 1: V = [-0.5, 0.5] and V' from V's top up to
+  // z_enter: [0.5, 5], mass 4.5.
+  const CellVolumes last = map.cellVolumes({1, 0});
+  ASSERT_EQ(last.positive.size(), 1u);
+  EXPECT_TRUE(volumeIs(last.positive[0], -0.5, 0.5, 1.0));
+  ASSERT_EQ(last.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(last.negative[0], 0.5, 5.0, 4.5));
+}
+
+TEST(Insertion, EntryExactlyOneAboveTheObstacleNeedsNoPadding) {
+  Map map(unitConfig());
+  map.insertReading({0.5, 0.5, 0}, {1.5, 0.5, 2}, true);
+  // Cell (0, 0): [0, 1] (height exactly 1). Cell (1, 0): z_enter = 1, L'_z = 2, |1 - 2| = 1 <= 1:
+  // only V = [1.5, 2.5].
+  const CellVolumes first = map.cellVolumes({0, 0});
+  ASSERT_EQ(first.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(first.negative[0], 0.0, 1.0, 1.0));
+  const CellVolumes last = map.cellVolumes({1, 0});
+  ASSERT_EQ(last.positive.size(), 1u);
+  EXPECT_TRUE(volumeIs(last.positive[0], 1.5, 2.5, 1.0));
+  EXPECT_TRUE(last.negative.empty());
+}
+
+TEST(Insertion, VerticalRays) {
+  Map map(unitConfig());
+  // Straight up 5: one cell, z_enter = 0, L'_z = 5: V = [4.5, 5.5], V' = [0, 4.5] (mass 4.5).
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, true);
+  CellVolumes cell = map.cellVolumes({0, 0});
+  ASSERT_EQ(cell.positive.size(), 1u);
+  ASSERT_EQ(cell.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.positive[0], 4.5, 5.5, 1.0));
+  EXPECT_TRUE(volumeIs(cell.negative[0], 0.0, 4.5, 4.5));
+  // Straight down 0.8 in another cell: |0 - (-0.8)| <= 1, V = [-1.3, -0.3] only.
+  map.insertReading({-2.5, 3.5, 0}, {-2.5, 3.5, -0.8}, true);
+  cell = map.cellVolumes({-3, 3});
+  ASSERT_EQ(cell.positive.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.positive[0], -1.3, -0.3, 1.0));
+  EXPECT_TRUE(cell.negative.empty());
+}
+
+TEST(Insertion, HorizontalRayMakesUnitVolumesAroundItsHeight) {
+  // A horizontal ray crosses every cell at one height z: eq. (6) gives [z - 0.5, z + 0.5].
+  Map map(MapConfig{0.5, 1000.0});
+  map.insertReading({0.1, 0.1, 1.0}, {2.1, 0.1, 1.0}, true);  // grid: x 0.2 -> 4.2, z = 2
+  for (int i = 0; i < 4; ++i) {
+    const CellVolumes cell = map.cellVolumes({i, 0});
+    ASSERT_EQ(cell.negative.size(), 1u) << "cell " << i;
+    EXPECT_TRUE(volumeIs(cell.negative[0], 1.5, 2.5, 1.0));
+  }
+  const CellVolumes last = map.cellVolumes({4, 0});
+  ASSERT_EQ(last.positive.size(), 1u);
+  EXPECT_TRUE(volumeIs(last.positive[0], 1.5, 2.5, 1.0));
+  EXPECT_TRUE(last.negative.empty());
+}
+
+// ---- Merging through the map (eqs. 7, 8) and mass conservation -------------------------------
+
+TEST(Insertion, ReadingsMergeAndConserveMass) {
+  Map map(unitConfig());
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 2}, false);  // eq. (4): [0, 2], mass 2
+  EXPECT_DOUBLE_EQ(totalMass(map), 2.0);
+  map.insertReading({0.5, 0.5, 2.5}, {0.5, 0.5, 4.5}, false);  // [2.5, 4.5], gap 0.5
+  // Eq. (8): [0, 4.5], mass 2 + 0.5 + 2 = 4.5.
+  CellVolumes cell = map.cellVolumes({0, 0});
+  ASSERT_EQ(cell.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.negative[0], 0.0, 4.5, 4.5));
+  EXPECT_DOUBLE_EQ(totalMass(map), 4.5);
+  map.insertReading({0.5, 0.5, 1}, {0.5, 0.5, 3}, false);  // [1, 3] inside: eq. (7), mass + 2
+  cell = map.cellVolumes({0, 0});
+  ASSERT_EQ(cell.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.negative[0], 0.0, 4.5, 6.5));
+  EXPECT_DOUBLE_EQ(totalMass(map), 6.5);
+  map.insertReading({0.5, 0.5, 6}, {0.5, 0.5, 7}, false);  // gap 1.5: a second volume
+  EXPECT_EQ(map.cellVolumes({0, 0}).negative.size(), 2u);
+  EXPECT_DOUBLE_EQ(totalMass(map), 7.5);
+  // Two hits 0.8 apart: [2.5, 3.5] and [4.3, 5.3] merge through the gap of 0.8:
+  // [2.5, 5.3], mass 1 + 0.8 + 1 = 2.8.
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 3}, true);
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 4.8}, true);
+  cell = map.cellVolumes({0, 0});
+  ASSERT_EQ(cell.positive.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.positive[0], 2.5, 5.3, 2.8));
+}
+
+TEST(Insertion, RandomReadingsKeepTheInvariants) {
+  // Thousands of random readings, one at a time: every list keeps the Sec. III-A constraints,
+  // and the total mass grows by at least 1 per reading (every reading creates at least one
+  // volume, of height >= 1 at density 1, and masses only ever add up).
+  Map map(MapConfig{0.5, 1000.0});
+  std::mt19937 rng(2024);
+  std::bernoulli_distribution is_obstacle(0.7);
+  double previous_total = 0.0;
+  for (int k = 0; k < 4000; ++k) {
+    const Eigen::Vector3d origin = test::randomPoint(rng, 20.0, 3.0);
+    const Eigen::Vector3d end = test::randomPoint(rng, 20.0, 3.0);
+    ASSERT_EQ(map.insertReading(origin, end, is_obstacle(rng)).inserted(), 1u);
+    const double total = totalMass(map);
+    ASSERT_GE(total, previous_total + 1.0 - 1e-6 * total) << "after reading " << k;
+    previous_total = total;
+    if (k % 500 == 0) {
+      ASSERT_TRUE(test::mapSatisfiesConstraints(map)) << "after reading " << k;
+    }
+  }
+  EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+  EXPECT_GE(previous_total, 4000.0);
+}
+
+// ---- InsertionConfig ---------------------------------------------------------------------------
+
+TEST(Insertion, MaxRangeTurnsFarHitsIntoFreeSpace) {
+  Map map(unitConfig());
+  InsertionConfig config;
+  config.max_range = 4.0;
+  // A hit 10 away along +x is cut at 4: free space over x in [0.5, 4.5], no obstacle.
+  const InsertionResult result = map.insertReading({0.5, 0.5, 0.5}, {10.5, 0.5, 0.5}, true, config);
+  EXPECT_EQ(result.obstacle_readings, 0u);
+  EXPECT_EQ(result.out_of_range_readings, 1u);
+  EXPECT_EQ(result.truncated_to_max_range, 1u);
+  for (int i = 0; i <= 4; ++i) {
+    const CellVolumes cell = map.cellVolumes({i, 0});
+    EXPECT_TRUE(cell.positive.empty());
+    ASSERT_EQ(cell.negative.size(), 1u) << "cell " << i;
+    EXPECT_TRUE(volumeIs(cell.negative[0], 0.0, 1.0, 1.0));
+  }
+  EXPECT_TRUE(map.cellVolumes({5, 0}).negative.empty());
+  EXPECT_EQ(map.bounds().max.x, 4);
+  // An out-of-range reading is cut too, and is not counted as a truncated hit.
+  const InsertionResult free_result =
+      map.insertReading({0.5, 0.5, 0.5}, {-9.5, 0.5, 0.5}, false, config);
+  EXPECT_EQ(free_result.out_of_range_readings, 1u);
+  EXPECT_EQ(free_result.truncated_to_max_range, 0u);
+  EXPECT_EQ(map.bounds().min.x, -4);
+  // A hit at exactly max_range stays an obstacle.
+  const InsertionResult at_range =
+      map.insertReading({0.5, 0.5, 0.5}, {0.5, 4.5, 0.5}, true, config);
+  EXPECT_EQ(at_range.obstacle_readings, 1u);
+  EXPECT_EQ(map.cellVolumes({0, 4}).positive.size(), 1u);
+}
+
+TEST(Insertion, MinRangeDropsNearHitsOnly) {
+  Map map(unitConfig());
+  InsertionConfig config;
+  config.min_range = 3.0;
+  InsertionResult result = map.insertReading({0.5, 0.5, 0}, {2.5, 0.5, 0}, true, config);
+  EXPECT_EQ(result.rejected_too_close, 1u);
+  EXPECT_EQ(result.inserted(), 0u);
+  EXPECT_TRUE(map.empty());
+  // Out-of-range readings carry free space whatever their length.
+  result = map.insertReading({0.5, 0.5, 0}, {2.5, 0.5, 0}, false, config);
+  EXPECT_EQ(result.out_of_range_readings, 1u);
+  // A hit at exactly min_range is kept.
+  result = map.insertReading({0.5, 0.5, 0}, {0.5, 3.5, 0}, true, config);
+  EXPECT_EQ(result.obstacle_readings, 1u);
+  EXPECT_EQ(map.cellVolumes({0, 3}).positive.size(), 1u);
+}
+
+TEST(Insertion, OutOfRangeReadingsCanBeIgnored) {
+  Map map(unitConfig());
+  InsertionConfig config;
+  config.insert_out_of_range = false;
+  config.max_range = 5.0;
+  EXPECT_EQ(map.insertReading({0.5, 0.5, 0}, {3.5, 0.5, 0}, false, config).ignored_out_of_range,
+            1u);
+  // A hit beyond max_range becomes an out-of-range reading, and is ignored too.
+  const InsertionResult far = map.insertReading({0.5, 0.5, 0}, {9.5, 0.5, 0}, true, config);
+  EXPECT_EQ(far.ignored_out_of_range, 1u);
+  EXPECT_EQ(far.inserted(), 0u);
+  EXPECT_TRUE(map.empty());
+  // Hits in range still bring their free space.
+  map.insertReading({0.5, 0.5, 0}, {3.5, 0.5, 0}, true, config);
+  EXPECT_EQ(map.cellVolumes({1, 0}).negative.size(), 1u);
+  EXPECT_EQ(map.cellVolumes({3, 0}).positive.size(), 1u);
+}
+
+TEST(Insertion, WithoutNegativeSpaceOnlyObstaclesAreStored) {
+  Map map(unitConfig());
+  InsertionConfig config;
+  config.model_negative_space = false;
+  const InsertionResult free_result =
+      map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, false, config);
+  EXPECT_EQ(free_result.out_of_range_readings, 1u);
+  EXPECT_TRUE(allVolumes(map).empty());
+  EXPECT_TRUE(map.empty());  // bounds() holds cells with volumes only
+  map.insertReading({0.5, 0.5, 0}, {0.5, 5.5, 9}, true, config);  // would need padding too
+  const std::vector<test::VolumeRecord> volumes = allVolumes(map);
+  ASSERT_EQ(volumes.size(), 1u);
+  EXPECT_EQ(volumes[0], (test::VolumeRecord{0, 5, 0, 8.5f, 9.5f, 1.0f}));
+  EXPECT_EQ(map.bounds().min, (CellIndex{0, 5}));
+  EXPECT_EQ(map.bounds().max, (CellIndex{0, 5}));
+}
+
+TEST(Insertion, BoundsHoldOnlyCellsWithVolumes) {
+  // A ray starting on the wall it leaves through never crosses its start cell: the start cell
+  // gets no volume, and bounds() must not include it.
+  Map map(unitConfig());
+  map.insertReading({2.0, 0.5, 0}, {-0.5, 0.5, 0}, false);
+  EXPECT_TRUE(map.cellVolumes({2, 0}).negative.empty());
+  EXPECT_EQ(map.bounds().min, (CellIndex{-1, 0}));
+  EXPECT_EQ(map.bounds().max, (CellIndex{1, 0}));
+  Scan scan;
+  scan.origin = {4.0, 0.5, 0};
+  scan.hits.push_back({3.5f, 0.5f, 0.0f});
+  map.insertScan(scan);
+  EXPECT_TRUE(map.cellVolumes({4, 0}).negative.empty());
+  EXPECT_EQ(map.bounds().max, (CellIndex{3, 0}));
+}
+
+TEST(Insertion, ResultCountsEveryReadingOnce) {
+  Map map(unitConfig(100.0));
+  InsertionConfig config;
+  config.min_range = 0.5;
+  config.max_range = 20.0;
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  Scan scan;
+  scan.origin = {0.5, 0.5, 0.0};
+  scan.hits = {{3, 1, 0},       {-4, 2, 1},      {5, -6, 0},  // obstacles
+               {kNaN, 0, 0},    {0, kInf, 0},                 // non-finite
+               {150, 0, 0},                                   // beyond max_coordinate
+               {0.6f, 0.5f, 0}, {0.5f, 0.5f, 0},              // too close (one of zero length)
+               {30, 0, 0}};                                   // truncated to max_range
+  scan.free_endpoints = {{10, 10, 0}, {-10, 3, 2}, {0, 0, -kInf}, {0, -101, 0}, {0.5f, 0.5f, 0}};
+  const InsertionResult result = map.insertScan(scan, config);
+  EXPECT_EQ(result.obstacle_readings, 3u);
+  EXPECT_EQ(result.out_of_range_readings, 3u);  // two free endpoints and the truncated hit
+  EXPECT_EQ(result.truncated_to_max_range, 1u);
+  EXPECT_EQ(result.rejected_non_finite, 3u);
+  EXPECT_EQ(result.rejected_out_of_bounds, 2u);
+  EXPECT_EQ(result.rejected_too_close, 3u);
+  EXPECT_EQ(result.ignored_out_of_range, 0u);
+  EXPECT_EQ(result.inserted() + result.rejected(), scan.hits.size() + scan.free_endpoints.size());
+
+  config.insert_out_of_range = false;
+  const InsertionResult ignoring = map.insertScan(scan, config);
+  EXPECT_EQ(ignoring.obstacle_readings, 3u);
+  EXPECT_EQ(ignoring.out_of_range_readings, 0u);
+  EXPECT_EQ(ignoring.truncated_to_max_range, 0u);
+  EXPECT_EQ(ignoring.ignored_out_of_range, 3u);
+  EXPECT_EQ(ignoring.inserted() + ignoring.rejected(),
+            scan.hits.size() + scan.free_endpoints.size());
+
+  InsertionResult sum = result;
+  sum += ignoring;
+  EXPECT_EQ(sum.obstacle_readings, 6u);
+  EXPECT_EQ(sum.out_of_range_readings, 3u);
+  EXPECT_EQ(sum.truncated_to_max_range, 1u);
+  EXPECT_EQ(sum.rejected_non_finite, 6u);
+  EXPECT_EQ(sum.rejected_out_of_bounds, 4u);
+  EXPECT_EQ(sum.rejected_too_close, 6u);
+  EXPECT_EQ(sum.ignored_out_of_range, 3u);
+}
+
+// ---- Scans -------------------------------------------------------------------------------------
+
+TEST(Insertion, ScanEqualsReadingByReading) {
+  MapConfig map_config;
+  map_config.resolution = 0.25;  // +-30 m: 240 cells, 15 tiles across, around the origin
+  Map by_scan(map_config);
+  Map by_reading(map_config);
+  std::mt19937 rng(11);
+  InsertionConfig config;
+  config.max_range = 25.0;
+  config.min_range = 0.2;
+  for (const Eigen::Vector3d& origin :
+       {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(-7, 5, 1)}) {
+    const Scan scan = test::randomScan(rng, origin, 2000, 1000, 30.0);
+    const InsertionResult scan_result = by_scan.insertScan(scan, config);
+    InsertionResult reading_result;
+    for (const Eigen::Vector3f& hit : scan.hits) {
+      reading_result += by_reading.insertReading(origin, hit.cast<double>(), true, config);
+    }
+    for (const Eigen::Vector3f& end : scan.free_endpoints) {
+      reading_result += by_reading.insertReading(origin, end.cast<double>(), false, config);
+    }
+    EXPECT_EQ(scan_result.obstacle_readings, reading_result.obstacle_readings);
+    EXPECT_EQ(scan_result.out_of_range_readings, reading_result.out_of_range_readings);
+    EXPECT_EQ(scan_result.truncated_to_max_range, reading_result.truncated_to_max_range);
+    EXPECT_EQ(scan_result.rejected(), reading_result.rejected());
+    EXPECT_GT(scan_result.truncated_to_max_range, 0u);
+  }
+  EXPECT_TRUE(test::sameVolumes(allVolumes(by_scan), allVolumes(by_reading)));
+  EXPECT_EQ(by_scan.bounds().min, by_reading.bounds().min);
+  EXPECT_EQ(by_scan.bounds().max, by_reading.bounds().max);
+  EXPECT_LT(by_scan.bounds().min.x, 0);
+  EXPECT_LT(by_scan.bounds().min.y, 0);
+}
+
+TEST(Insertion, ThreadsBuildTheSameMap) {
+  // A scan of 9000 readings (more than one internal chunk of 8192) and two smaller ones, over
+  // about 8 x 8 tiles around the origin, into maps built with 1 to 4 threads: identical volumes,
+  // bit for bit.
+  MapConfig map_config;
+  map_config.resolution = 0.25;
+  std::mt19937 rng(99);
+  const std::vector<Scan> scans{test::randomScan(rng, {0.0, 0.0, 0.0}, 7000, 2000, 12.0),
+                                test::randomScan(rng, {-5.5, 3.25, 1.0}, 1500, 500, 12.0),
+                                test::randomScan(rng, {4.0, -3.0, -1.0}, 1500, 500, 12.0)};
+  for (bool clear_conflicts : {false, true}) {
+    SCOPED_TRACE(clear_conflicts ? "clearing conflicting free space" : "plain");
+    std::vector<std::vector<test::VolumeRecord>> maps;
+    std::vector<CellRange> bounds;
+    for (int threads = 1; threads <= 4; ++threads) {
+      Map map(map_config);
+      InsertionConfig config;
+      config.num_threads = threads;
+      config.clear_conflicting_free_space = clear_conflicts;
+      for (const Scan& scan : scans) map.insertScan(scan, config);
+      if (threads == 1) {
+        EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+      }
+      maps.push_back(allVolumes(map));
+      bounds.push_back(map.bounds());
+    }
+    EXPECT_LT(bounds[0].min.x, -40);
+    EXPECT_LT(bounds[0].min.y, -40);
+    for (int threads = 2; threads <= 4; ++threads) {
+      EXPECT_TRUE(test::sameVolumes(maps[threads - 1], maps[0])) << threads << " threads";
+      EXPECT_EQ(bounds[threads - 1].min, bounds[0].min);
+      EXPECT_EQ(bounds[threads - 1].max, bounds[0].max);
+    }
+  }
+}
+
+// ---- Sec. V.B: clear_conflicting_free_space -----------------------------------------------------
+
+TEST(Insertion, ConflictingFreeSpaceOfTheSameScanIsDropped) {
+  Scan scan;
+  scan.origin = {0.5, 0.5, 0.5};
+  scan.hits.push_back({5.5f, 0.5f, 0.5f});  // A: positive [0, 1] in cell (5, 0)
+  scan.hits.push_back({8.5f, 0.5f, 0.5f});  // B: crosses cell (5, 0) at z = 0.5: [0, 1] there
+  scan.free_endpoints.push_back({9.5f, 0.5f, 9.5f});  // C: crosses cell (5, 0) at z in [5, 6]
+  for (bool clear_conflicts : {false, true}) {
+    SCOPED_TRACE(clear_conflicts ? "clearing" : "not clearing");
+    Map map(unitConfig());
+    InsertionConfig config;
+    config.clear_conflicting_free_space = clear_conflicts;
+    map.insertScan(scan, config);
+    const CellVolumes cell = map.cellVolumes({5, 0});
+    ASSERT_EQ(cell.positive.size(), 1u);
+    EXPECT_TRUE(volumeIs(cell.positive[0], 0.0, 1.0, 1.0));
+    // C's free space does not overlap A's obstacle: kept either way.
+    ASSERT_EQ(cell.negative.size(), clear_conflicts ? 1u : 2u);
+    EXPECT_TRUE(volumeIs(cell.negative.back(), 5.0, 6.0, 1.0));
+    if (!clear_conflicts) {
+      EXPECT_TRUE(volumeIs(cell.negative.front(), 0.0, 1.0, 1.0));
+    }
+    // Cells without a positive volume of this scan keep all their free space.
+    EXPECT_EQ(map.cellVolumes({4, 0}).negative.size(), 2u);
+    EXPECT_EQ(map.cellVolumes({7, 0}).negative.size(), 2u);
+    // B's own obstacle is kept.
+    EXPECT_EQ(map.cellVolumes({8, 0}).positive.size(), 1u);
+  }
+}
+
+TEST(Insertion, FreeSpaceTouchingAnObstacleIsNoConflict) {
+  // A steep hit straight up: V = [4.5, 5.5] and its padding [0.5, 4.5] touch at 4.5 without
+  // overlapping, so the padding is kept.
+  Scan scan;
+  scan.origin = {0.5, 0.5, 0.5};
+  scan.hits.push_back({0.5f, 0.5f, 5.0f});
+  Map map(unitConfig());
+  InsertionConfig config;
+  config.clear_conflicting_free_space = true;
+  map.insertScan(scan, config);
+  const CellVolumes cell = map.cellVolumes({0, 0});
+  ASSERT_EQ(cell.positive.size(), 1u);
+  ASSERT_EQ(cell.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.negative[0], 0.5, 4.5, 4.0));
+}
+
+TEST(Insertion, ConflictsAreOnlyWithinOneScan) {
+  // The obstacle of an earlier scan does not stop the free space of a later one.
+  Map map(unitConfig());
+  InsertionConfig config;
+  config.clear_conflicting_free_space = true;
+  Scan first;
+  first.origin = {0.5, 0.5, 0.5};
+  first.hits.push_back({3.5f, 0.5f, 0.5f});
+  map.insertScan(first, config);
+  Scan second = first;
+  second.hits = {{6.5f, 0.5f, 0.5f}};
+  map.insertScan(second, config);
+  EXPECT_EQ(map.cellVolumes({3, 0}).negative.size(), 1u);
+  EXPECT_EQ(map.cellVolumes({3, 0}).positive.size(), 1u);
+}
+
+}  // namespace
+}  // namespace mvog

@@ -1,0 +1,224 @@
+// Helpers shared by the core's tests: building maps, reading every volume of a map, and checking
+// the Sec. III-A constraints independently of mvog::checkVolumeList.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <sstream>
+#include <tuple>
+#include <vector>
+
+#include "mvog/map.h"
+#include "mvog/volume.h"
+
+namespace mvog {
+namespace test {
+
+/// A map at resolution 1 (s = 1): grid units are metres, as in the paper's Fig. 3.
+inline MapConfig unitConfig(double max_coordinate = 10000.0) {
+  MapConfig config;
+  config.resolution = 1.0;
+  config.max_coordinate = max_coordinate;
+  return config;
+}
+
+/// Tolerance for heights and masses computed by hand in double from numbers stored as floats.
+constexpr double kTolerance = 1e-5;
+
+/// `v` spans [bottom, top] with mass `mass`, up to kTolerance.
+inline ::testing::AssertionResult volumeIs(const Volume& v, double bottom, double top,
+                                           double mass) {
+  if (std::fabs(v.bottom - bottom) <= kTolerance && std::fabs(v.top - top) <= kTolerance &&
+      std::fabs(v.mass - mass) <= kTolerance) {
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure()
+         << "volume [" << v.bottom << ", " << v.top << "] mass " << v.mass << ", expected ["
+         << bottom << ", " << top << "] mass " << mass;
+}
+
+/// One volume of a map: cell x, cell y, sign, bottom, top, mass. Compared with ==, i.e. exactly.
+using VolumeRecord = std::tuple<std::int32_t, std::int32_t, int, float, float, float>;
+
+/// Every volume of `map`, in forEachVolume's order.
+inline std::vector<VolumeRecord> allVolumes(const Map& map) {
+  std::vector<VolumeRecord> records;
+  map.forEachVolume([&](const CellIndex& cell, VolumeSign sign, const Volume& v) {
+    records.emplace_back(cell.x, cell.y, static_cast<int>(sign), v.bottom, v.top, v.mass);
+  });
+  return records;
+}
+
+/// Two lists of volume records are equal; otherwise says how many differ, and the first.
+inline ::testing::AssertionResult sameVolumes(const std::vector<VolumeRecord>& a,
+                                              const std::vector<VolumeRecord>& b) {
+  const std::size_t common = std::min(a.size(), b.size());
+  std::size_t differences = std::max(a.size(), b.size()) - common;
+  std::size_t first = common;
+  for (std::size_t k = 0; k < common; ++k) {
+    if (a[k] == b[k]) continue;
+    ++differences;
+    first = std::min(first, k);
+  }
+  if (differences == 0) return ::testing::AssertionSuccess();
+  auto failure = ::testing::AssertionFailure();
+  failure << a.size() << " and " << b.size() << " volumes, " << differences << " differ";
+  if (first < common) {
+    failure << ", the first: " << ::testing::PrintToString(a[first]) << " vs "
+            << ::testing::PrintToString(b[first]);
+  }
+  return failure;
+}
+
+/// Sum of every volume's mass.
+inline double totalMass(const Map& map) {
+  double total = 0.0;
+  map.forEachVolume([&](const CellIndex&, VolumeSign, const Volume& v) { total += v.mass; });
+  return total;
+}
+
+/// The cells holding at least one volume.
+inline std::vector<CellIndex> observedCells(const Map& map) {
+  std::vector<CellIndex> cells;
+  map.forEachVolume([&](const CellIndex& cell, VolumeSign, const Volume&) {
+    if (cells.empty() || cells.back() != cell) cells.push_back(cell);
+  });
+  return cells;
+}
+
+/// Sec. III-A written out again, without mvog::checkVolumeList: sorted, heights >= 1, no overlap,
+/// gaps > 1 (in float, as the map computes them), finite non-negative masses.
+inline ::testing::AssertionResult satisfiesConstraints(const std::vector<Volume>& list) {
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const Volume& v = list[k];
+    std::ostringstream where;
+    where << "volume " << k << " [" << v.bottom << ", " << v.top << "] mass " << v.mass << ": ";
+    if (!std::isfinite(v.bottom) || !std::isfinite(v.top) || !(v.top - v.bottom >= 1.0f)) {
+      return ::testing::AssertionFailure() << where.str() << "height below 1";
+    }
+    if (!std::isfinite(v.mass) || v.mass < 0.0f) {
+      return ::testing::AssertionFailure() << where.str() << "mass not finite and >= 0";
+    }
+    if (k > 0) {
+      const Volume& below = list[k - 1];
+      if (!(below.bottom < v.bottom) || !(below.top < v.bottom)) {
+        return ::testing::AssertionFailure() << where.str() << "unsorted or overlapping";
+      }
+      if (!(v.bottom - below.top > 1.0f)) {
+        return ::testing::AssertionFailure() << where.str() << "gap to the one below is <= 1";
+      }
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+/// Both the independent check and mvog::checkVolumeList hold for every list of `map`.
+inline ::testing::AssertionResult mapSatisfiesConstraints(const Map& map) {
+  for (const CellIndex& cell : observedCells(map)) {
+    const CellVolumes volumes = map.cellVolumes(cell);
+    for (const std::vector<Volume>* list : {&volumes.positive, &volumes.negative}) {
+      const char* name = list == &volumes.positive ? "positive" : "negative";
+      const ::testing::AssertionResult own = satisfiesConstraints(*list);
+      if (!own) {
+        return ::testing::AssertionFailure()
+               << "cell (" << cell.x << ", " << cell.y << ") " << name << ": " << own.message();
+      }
+      const std::string problem = checkVolumeList(list->data(), list->size());
+      if (!problem.empty()) {
+        return ::testing::AssertionFailure() << "cell (" << cell.x << ", " << cell.y << ") " << name
+                                             << ": checkVolumeList: " << problem;
+      }
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+/// Marks an unknown probability in probabilityBits (no probability has this NaN pattern).
+constexpr std::uint32_t kUnknownBits = 0xffffffffu;
+
+/// The probability at the points of a lattice over [-half_extent, half_extent]^2 x
+/// [-half_height, half_height] (m) as float bits, kUnknownBits where unknown: equal vectors mean
+/// bit-for-bit equal probabilities everywhere on the lattice.
+inline std::vector<std::uint32_t> probabilityBits(const Map& map, double half_extent,
+                                                  double half_height) {
+  std::vector<std::uint32_t> bits;
+  for (double x = -half_extent; x <= half_extent; x += 0.13) {
+    for (double y = -half_extent; y <= half_extent; y += 0.17) {
+      for (double z = -half_height; z <= half_height; z += 0.11) {
+        const PointOccupancy p = map.occupancy({x, y, z});
+        std::uint32_t b = kUnknownBits;
+        if (p.known()) std::memcpy(&b, &*p.probability, sizeof b);
+        bits.push_back(b);
+      }
+    }
+  }
+  return bits;
+}
+
+/// Two probabilityBits vectors are equal; otherwise says how many points differ, and the first.
+inline ::testing::AssertionResult sameProbabilities(const std::vector<std::uint32_t>& a,
+                                                    const std::vector<std::uint32_t>& b) {
+  if (a.size() != b.size()) return ::testing::AssertionFailure() << "different lattices";
+  std::size_t differences = 0;
+  std::size_t first = a.size();
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (a[k] == b[k]) continue;
+    ++differences;
+    first = std::min(first, k);
+  }
+  if (differences == 0) return ::testing::AssertionSuccess();
+  float p_a;
+  float p_b;
+  std::memcpy(&p_a, &a[first], sizeof p_a);
+  std::memcpy(&p_b, &b[first], sizeof p_b);
+  return ::testing::AssertionFailure()
+         << differences << " of " << a.size() << " probabilities differ, the first " << p_a
+         << " vs " << p_b << " (NaN: unknown)";
+}
+
+/// A point uniformly in [-half_extent, half_extent]^2 x [-half_height, half_height].
+inline Eigen::Vector3d randomPoint(std::mt19937& rng, double half_extent, double half_height) {
+  std::uniform_real_distribution<double> horizontal(-half_extent, half_extent);
+  std::uniform_real_distribution<double> vertical(-half_height, half_height);
+  const double x = horizontal(rng);
+  const double y = horizontal(rng);
+  return {x, y, vertical(rng)};
+}
+
+/// A scan from `origin` with `num_hits` obstacle readings and `num_free` out-of-range readings at
+/// random points within half_extent (m) of the origin horizontally, and z in [-3, 3] (m).
+inline Scan randomScan(std::mt19937& rng, const Eigen::Vector3d& origin, std::size_t num_hits,
+                       std::size_t num_free, double half_extent) {
+  Scan scan;
+  scan.origin = origin;
+  const auto point = [&] {
+    const Eigen::Vector3d p =
+        randomPoint(rng, half_extent, 3.0) + Eigen::Vector3d(origin.x(), origin.y(), 0.0);
+    return p.cast<float>().eval();
+  };
+  for (std::size_t k = 0; k < num_hits; ++k) scan.hits.push_back(point());
+  for (std::size_t k = 0; k < num_free; ++k) scan.free_endpoints.push_back(point());
+  return scan;
+}
+
+/// A map built from `num_scans` random scans from near the origin, each of 1200 hits and 400
+/// out-of-range readings within half_extent (m).
+inline Map randomMap(unsigned seed, double resolution, double half_extent, int num_scans = 3) {
+  MapConfig config;
+  config.resolution = resolution;
+  config.max_coordinate = 1000.0;
+  Map map(config);
+  std::mt19937 rng(seed);
+  for (int k = 0; k < num_scans; ++k) {
+    map.insertScan(randomScan(rng, randomPoint(rng, 1.0, 0.5), 1200, 400, half_extent));
+  }
+  return map;
+}
+
+}  // namespace test
+}  // namespace mvog

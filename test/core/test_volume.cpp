@@ -1,0 +1,334 @@
+// Volume lists (Sec. III-A) and the constraint application of Sec. III-B.3: eqs. (2), (6), (7),
+// (8), through the functions of volume.h.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
+#include <limits>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "mvog/volume.h"
+#include "test_util.h"
+
+namespace mvog {
+namespace {
+
+using test::satisfiesConstraints;
+using test::volumeIs;
+
+/// Inserts `volume` into a copy of `list` with insertVolume and returns the resulting list.
+std::vector<Volume> inserted(std::vector<Volume> list, const Volume& volume,
+                             float unit_mass = 1.0f) {
+  list.push_back({});  // insertVolume needs room for one more
+  const std::uint32_t count =
+      insertVolume(list.data(), static_cast<std::uint32_t>(list.size() - 1), volume, unit_mass);
+  list.resize(count);
+  return list;
+}
+
+/// A new volume of density 1 (mass = height) spanning [bottom, top].
+Volume fresh(float bottom, float top) { return Volume{bottom, top, top - bottom}; }
+
+// ---- Eq. (2) ----------------------------------------------------------------------------------
+
+TEST(Volume, DensityIsMassPerHeight) {
+  // Eq. (2) with A = 1 (grid units): rho = m / (top - bottom).
+  EXPECT_FLOAT_EQ((Volume{1.0f, 5.0f, 2.0f}.density()), 0.5f);
+  EXPECT_FLOAT_EQ((Volume{-2.0f, 1.0f, 9.0f}.density()), 3.0f);
+  EXPECT_FLOAT_EQ((Volume{0.0f, 1.0f, 0.0f}.density()), 0.0f);
+  EXPECT_FLOAT_EQ((Volume{0.0f, 2.5f, 2.5f}.height()), 2.5f);
+}
+
+TEST(Volume, ContainsIsAClosedInterval) {
+  const Volume v{1.0f, 3.0f, 2.0f};
+  EXPECT_TRUE(v.contains(1.0f));
+  EXPECT_TRUE(v.contains(2.0f));
+  EXPECT_TRUE(v.contains(3.0f));
+  EXPECT_FALSE(v.contains(0.999f));
+  EXPECT_FALSE(v.contains(3.001f));
+  EXPECT_FALSE(v.contains(std::numeric_limits<float>::quiet_NaN()));
+}
+
+// ---- Eq. (6) and new volumes at density 1 -----------------------------------------------------
+
+TEST(MakeVolume, TallVolumeKeepsItsExtentAtDensityOne) {
+  EXPECT_TRUE(volumeIs(makeVolume(1.5f, 5.0f, 1.0f), 1.5, 5.0, 3.5));
+  EXPECT_TRUE(volumeIs(makeVolume(5.0f, 1.5f, 1.0f), 1.5, 5.0, 3.5));  // either order
+  EXPECT_TRUE(volumeIs(makeVolume(-3.0f, -1.0f, 1.0f), -3.0, -1.0, 2.0));
+}
+
+TEST(MakeVolume, HeightExactlyOneIsKept) {
+  EXPECT_TRUE(volumeIs(makeVolume(2.0f, 3.0f, 1.0f), 2.0, 3.0, 1.0));
+}
+
+TEST(MakeVolume, ShortVolumeIsCentredToHeightOne) {
+  // Eq. (6): [2.2, 2.6] has centre 2.4, so V* = [2.4 - 0.5, 2.4 + 0.5] = [1.9, 2.9], mass 1.
+  EXPECT_TRUE(volumeIs(makeVolume(2.2f, 2.6f, 1.0f), 1.9, 2.9, 1.0));
+  EXPECT_TRUE(volumeIs(makeVolume(2.6f, 2.2f, 1.0f), 1.9, 2.9, 1.0));
+  // A single point (a horizontal ray over a cell) becomes [z - 0.5, z + 0.5].
+  EXPECT_TRUE(volumeIs(makeVolume(-4.25f, -4.25f, 1.0f), -4.75, -3.75, 1.0));
+}
+
+TEST(MakeVolume, MassIsTheFinalHeightTimesTheUnit) {
+  // Density 1 in the stored-mass unit: mass = final height * unit_mass.
+  EXPECT_TRUE(volumeIs(makeVolume(0.0f, 2.0f, 0.5f), 0.0, 2.0, 1.0));
+  EXPECT_TRUE(volumeIs(makeVolume(0.0f, 0.2f, 4.0f), -0.4, 0.6, 4.0));
+}
+
+TEST(MakeVolume, MinimumHeightHoldsFarFromZero) {
+  // Around 2^22 a float resolves half units only; the minimum height must still hold.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> centre(-4194304.0f, 4194304.0f);
+  std::uniform_real_distribution<float> half_span(0.0f, 0.5f);
+  for (int k = 0; k < 10000; ++k) {
+    const float c = centre(rng);
+    const float h = half_span(rng);
+    const Volume v = makeVolume(c - h, c + h, 1.0f);
+    ASSERT_GE(v.top - v.bottom, 1.0f) << "around " << c;
+    ASSERT_FLOAT_EQ(v.mass, v.top - v.bottom);
+  }
+}
+
+// ---- Eq. (7): overlapping volumes merge with summed masses -----------------------------------
+
+TEST(InsertVolume, IntoEmptyList) {
+  const std::vector<Volume> list = inserted({}, fresh(1.0f, 2.0f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 1.0, 2.0, 1.0));
+}
+
+TEST(InsertVolume, DistantVolumesStaySeparateAndSorted) {
+  std::vector<Volume> list;
+  for (float bottom : {10.0f, 0.0f, 20.0f, 5.0f}) list = inserted(list, fresh(bottom, bottom + 1));
+  ASSERT_EQ(list.size(), 4u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 1.0, 1.0));
+  EXPECT_TRUE(volumeIs(list[1], 5.0, 6.0, 1.0));
+  EXPECT_TRUE(volumeIs(list[2], 10.0, 11.0, 1.0));
+  EXPECT_TRUE(volumeIs(list[3], 20.0, 21.0, 1.0));
+  EXPECT_TRUE(satisfiesConstraints(list));
+}
+
+TEST(InsertVolume, PartialOverlapMergesIntoTheUnionWithSummedMass) {
+  // Eq. (7): [0, 2] (mass 2) u [1.5, 3.5] (mass 2) = [0, 3.5], mass 2 + 2 = 4.
+  const std::vector<Volume> list = inserted({fresh(0.0f, 2.0f)}, fresh(1.5f, 3.5f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 3.5, 4.0));
+}
+
+TEST(InsertVolume, OverlapFromBelow) {
+  const std::vector<Volume> list = inserted({fresh(5.0f, 7.0f)}, fresh(4.0f, 5.5f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 4.0, 7.0, 3.5));
+}
+
+TEST(InsertVolume, TouchingVolumesOverlap) {
+  // Closed intervals: z_B^bot = 2 lies in [z_A^bot, z_A^top] = [0, 2], so they overlap (eq. 7).
+  std::vector<Volume> list = inserted({fresh(0.0f, 2.0f)}, fresh(2.0f, 4.0f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 4.0, 4.0));
+  list = inserted({fresh(2.0f, 4.0f)}, fresh(0.0f, 2.0f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 4.0, 4.0));
+}
+
+TEST(InsertVolume, ContainedVolumeAddsItsMassOnly) {
+  // [3, 4] inside [0, 10]: the union is [0, 10], the masses add: 10 + 1 = 11 (density 1.1).
+  std::vector<Volume> list = inserted({fresh(0.0f, 10.0f)}, fresh(3.0f, 4.0f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 10.0, 11.0));
+  // And the other way round: a new volume swallowing an old one.
+  list = inserted({fresh(3.0f, 4.0f)}, fresh(0.0f, 10.0f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 10.0, 11.0));
+}
+
+TEST(InsertVolume, MergeKeepsTheDensitiesMasses) {
+  // Old [0, 2] at density 3 (mass 6), new [1, 3] at density 1: union [0, 3], mass 6 + 2 = 8.
+  const std::vector<Volume> list = inserted({Volume{0.0f, 2.0f, 6.0f}}, fresh(1.0f, 3.0f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 3.0, 8.0));
+}
+
+TEST(InsertVolume, OneVolumeOverlappingSeveralMergesThemAll) {
+  // [0.5, 6.5] overlaps [0, 1], [3, 4] and [6, 7]: union [0, 7], masses 1 + 1 + 1 + 6 = 9; the
+  // union has no gap left, so nothing is added for gaps.
+  const std::vector<Volume> list =
+      inserted({fresh(0.0f, 1.0f), fresh(3.0f, 4.0f), fresh(6.0f, 7.0f), fresh(20.0f, 21.0f)},
+               fresh(0.5f, 6.5f));
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 7.0, 9.0));
+  EXPECT_TRUE(volumeIs(list[1], 20.0, 21.0, 1.0));
+}
+
+// ---- Eq. (8): gaps in (0, 1] are filled at density 1 ------------------------------------------
+
+TEST(InsertVolume, GapBelowOneMergesAndAddsTheGapMass) {
+  // Gap [1, 1.5] of 0.5: V* = [0, 2.5], m = 1 + 0.5 (gap at density 1) + 1 = 2.5.
+  std::vector<Volume> list = inserted({fresh(0.0f, 1.0f)}, fresh(1.5f, 2.5f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 2.5, 2.5));
+  // Same with the new volume below.
+  list = inserted({fresh(1.5f, 2.5f)}, fresh(0.0f, 1.0f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 2.5, 2.5));
+}
+
+TEST(InsertVolume, GapOfExactlyOneMerges) {
+  // z_B^bot - z_A^top = 1 lies in (0, 1]: merge, m = 1 + 1 + 1 = 3.
+  const std::vector<Volume> list = inserted({fresh(0.0f, 1.0f)}, fresh(2.0f, 3.0f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 3.0, 3.0));
+}
+
+TEST(InsertVolume, GapAboveOneDoesNotMerge) {
+  const std::vector<Volume> list = inserted({fresh(0.0f, 1.0f)}, fresh(2.001f, 3.001f));
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 1.0, 1.0));
+  EXPECT_TRUE(volumeIs(list[1], 2.001, 3.001, 1.0));
+  // The smallest float gap above 1.
+  const float bottom = std::nextafter(2.0f, 3.0f);
+  EXPECT_EQ(inserted({fresh(0.0f, 1.0f)}, fresh(bottom, bottom + 1.0f)).size(), 2u);
+}
+
+TEST(InsertVolume, GapMassFollowsTheUnit) {
+  // Stored masses in a unit of 0.5: the new volumes have mass 0.5 (density 1 real), and so does
+  // the gap per unit height: 0.5 + 0.5 * 0.5 + 0.5 = 1.25.
+  const std::vector<Volume> list =
+      inserted({Volume{0.0f, 1.0f, 0.5f}}, Volume{1.5f, 2.5f, 0.5f}, 0.5f);
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 2.5, 1.25));
+}
+
+TEST(InsertVolume, VolumeBetweenTwoFillsBothGaps) {
+  // [1.5, 2.5] sits 0.5 above [0, 1] and 0.5 below [3, 4]: one volume [0, 4],
+  // m = 1 + 1 + 1 + 0.5 + 0.5 = 4.
+  const std::vector<Volume> list =
+      inserted({fresh(0.0f, 1.0f), fresh(3.0f, 4.0f)}, fresh(1.5f, 2.5f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 4.0, 4.0));
+}
+
+TEST(InsertVolume, OverlapOnOneSideAndGapOnTheOther) {
+  // [1, 2.5] touches [0, 1] and is 0.5 below [3, 4]: [0, 4], m = 1 + 1.5 + 1 + 0.5 = 4.
+  const std::vector<Volume> list =
+      inserted({fresh(0.0f, 1.0f), fresh(3.0f, 4.0f)}, fresh(1.0f, 2.5f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 4.0, 4.0));
+}
+
+TEST(InsertVolume, ChainOfMergesAcrossManyVolumes) {
+  // Volumes [3k, 3k + 1] for k = 0..4 (gaps of 2, so they stay apart), then [1.5, 11.5]: it
+  // contains [3, 4], [6, 7], [9, 10] (eq. 7) and lies 0.5 from [0, 1] and [12, 13] (eq. 8).
+  std::vector<Volume> list;
+  for (float bottom : {0.0f, 3.0f, 6.0f, 9.0f, 12.0f})
+    list = inserted(list, fresh(bottom, bottom + 1));
+  ASSERT_EQ(list.size(), 5u);
+  list = inserted(list, fresh(1.5f, 11.5f));
+  ASSERT_EQ(list.size(), 1u);
+  // The union is [0, 13]; the gaps left in it are [1, 1.5] and [11.5, 12], filled at density 1.
+  // m = 5 * 1 (old) + 10 (new) + 0.5 + 0.5 (gaps) = 16.
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 13.0, 16.0));
+}
+
+TEST(InsertVolume, MergedVolumeIsFarFromItsNeighbours) {
+  // The merged volume [2.5, 6] keeps a gap > 1 to [0, 1] (1.5) and to [7.25, 8.25] (1.25).
+  const std::vector<Volume> list =
+      inserted({fresh(0.0f, 1.0f), fresh(2.5f, 4.0f), fresh(7.25f, 8.25f)}, fresh(4.5f, 6.0f));
+  ASSERT_EQ(list.size(), 3u);
+  EXPECT_TRUE(volumeIs(list[1], 2.5, 6.0, 1.5 + 0.5 + 1.5));
+  EXPECT_TRUE(satisfiesConstraints(list));
+}
+
+TEST(InsertVolume, RandomInsertionsKeepTheConstraintsAndConserveMass) {
+  // Mass conservation: inserting v (density 1, so m_v = its height) adds m_v plus the gaps it
+  // fills at density 1. The covered length grows by |v| - overlap(v, list) + gaps, hence
+  //   mass_after - mass_before = covered_after - covered_before + overlap(v, list).
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<float> bottom(-50.0f, 50.0f);
+  std::uniform_real_distribution<float> height(0.0f, 3.0f);
+  std::vector<Volume> list;
+  const auto mass_and_length = [](const std::vector<Volume>& l) {
+    double mass = 0.0;
+    double length = 0.0;
+    for (const Volume& v : l) {
+      mass += v.mass;
+      length += v.height();
+    }
+    return std::make_pair(mass, length);
+  };
+  for (int k = 0; k < 5000; ++k) {
+    const float b = bottom(rng);
+    const Volume v = makeVolume(b, b + height(rng), 1.0f);
+    double overlap = 0.0;
+    for (const Volume& old : list) {
+      overlap += std::max(0.0, double{std::min(old.top, v.top)} - std::max(old.bottom, v.bottom));
+    }
+    const auto [mass_before, length_before] = mass_and_length(list);
+    list = inserted(list, v);
+    const auto [mass_after, length_after] = mass_and_length(list);
+    ASSERT_TRUE(satisfiesConstraints(list)) << "after insertion " << k;
+    ASSERT_EQ(checkVolumeList(list.data(), list.size()), "") << "after insertion " << k;
+    ASSERT_NEAR(mass_after - mass_before, length_after - length_before + overlap, 1e-5 * mass_after)
+        << "after insertion " << k;
+    ASSERT_GE(mass_after, mass_before + v.mass - 1e-5 * mass_after) << "after insertion " << k;
+  }
+}
+
+// ---- findVolume ---------------------------------------------------------------------------------
+
+TEST(FindVolume, FindsTheVolumeContainingAHeight) {
+  const std::vector<Volume> list{fresh(0.0f, 1.0f), fresh(3.0f, 5.0f), fresh(7.0f, 8.0f)};
+  const auto find = [&](float z) { return findVolume(list.data(), 3, z); };
+  EXPECT_EQ(find(0.0f), &list[0]);  // closed intervals: both faces belong to the volume
+  EXPECT_EQ(find(1.0f), &list[0]);
+  EXPECT_EQ(find(3.0f), &list[1]);
+  EXPECT_EQ(find(4.0f), &list[1]);
+  EXPECT_EQ(find(5.0f), &list[1]);
+  EXPECT_EQ(find(8.0f), &list[2]);
+  EXPECT_EQ(find(-0.01f), nullptr);
+  EXPECT_EQ(find(2.0f), nullptr);
+  EXPECT_EQ(find(6.0f), nullptr);
+  EXPECT_EQ(find(8.01f), nullptr);
+  EXPECT_EQ(find(std::numeric_limits<float>::quiet_NaN()), nullptr);
+  EXPECT_EQ(findVolume(list.data(), 0, 0.5f), nullptr);
+}
+
+// ---- checkVolumeList
+// ------------------------------------------------------------------------------
+
+TEST(CheckVolumeList, AcceptsValidLists) {
+  EXPECT_EQ(checkVolumeList(nullptr, 0), "");
+  const std::vector<Volume> list{fresh(0.0f, 1.0f), Volume{2.5f, 4.0f, 0.0f}};
+  EXPECT_EQ(checkVolumeList(list.data(), list.size()), "");
+}
+
+TEST(CheckVolumeList, RefusesEveryViolation) {
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const std::vector<std::vector<Volume>> bad{
+      {Volume{0.0f, 0.5f, 0.5f}},                     // height below 1
+      {Volume{1.0f, 0.0f, 1.0f}},                     // upside down
+      {fresh(0.0f, 1.0f), fresh(2.0f, 3.0f)},         // gap of exactly 1
+      {fresh(0.0f, 2.0f), fresh(1.0f, 3.0f)},         // overlap
+      {fresh(5.0f, 6.0f), fresh(0.0f, 1.0f)},         // unsorted
+      {Volume{0.0f, 1.0f, -1.0f}},                    // negative mass
+      {Volume{0.0f, 1.0f, kNaN}},                     // NaN mass
+      {Volume{0.0f, 1.0f, kInf}},                     // infinite mass
+      {Volume{kNaN, 1.0f, 1.0f}},                     // NaN bottom
+      {Volume{0.0f, kInf, 1.0f}},                     // infinite top
+      {Volume{-kInf, 0.0f, 1.0f}},                    // infinite bottom
+      {fresh(0.0f, 1.0f), Volume{5.0f, 5.5f, 0.5f}},  // second volume too short
+  };
+  for (const std::vector<Volume>& list : bad) {
+    EXPECT_NE(checkVolumeList(list.data(), list.size()), "")
+        << "accepted [" << list.back().bottom << ", " << list.back().top << "] mass "
+        << list.back().mass;
+    EXPECT_FALSE(satisfiesConstraints(list));  // the tests' own check agrees
+  }
+}
+
+}  // namespace
+}  // namespace mvog
