@@ -19,6 +19,9 @@ struct RunOptions {
   /// backends (OctoMap's insertPointCloud maxrange); infinity: no limit.
   double max_range = 0.0;
   int threads = 1;  ///< MVOG only; OctoMap's insertion is single-threaded
+  /// MVOG only: InsertionConfig::clear_conflicting_free_space (Sec. V.B), the counterpart of
+  /// OctoMap's insertPointCloud, where a scan's occupied voxels win over its free ones.
+  bool clear_conflicting_free_space = false;
 };
 
 struct MvogStats {

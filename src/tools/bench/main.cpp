@@ -1,6 +1,7 @@
 // mvog_bench: MVOG against OctoMap on the same rays from a ROS bag or an OctoMap scan graph.
 //   mvog_bench --input FILE [--resolution R]... [--max-range M] [--threads N]
 //              [--backend mvog|octomap|both] [--json OUT] [--fixed-frame FRAME]
+//              [--clear-conflicting-free-space]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
 #include <chrono>
 #include <cmath>
@@ -25,6 +26,7 @@ struct Arguments {
   std::vector<double> resolutions;
   double max_range = std::numeric_limits<double>::infinity();
   int threads = 1;
+  bool clear_conflicting_free_space = false;
   bool run_mvog = true;
   bool run_octomap = true;
   std::string json;
@@ -39,12 +41,15 @@ class UsageError : public std::runtime_error {
 constexpr const char* kUsage =
     "usage: mvog_bench --input FILE [--resolution R]... [--max-range M] [--threads N]\n"
     "                  [--backend mvog|octomap|both] [--json OUT] [--fixed-frame FRAME]\n"
+    "                  [--clear-conflicting-free-space]\n"
     "  FILE        a ROS bag (LaserScan and/or PointCloud2, poses from /tf and /tf_static)\n"
     "              or an OctoMap ScanGraph (.graph)\n"
     "  R           cell size in metres, repeatable (default 0.1)\n"
     "  M           hits further than M metres insert free space only, truncated (default: none)\n"
     "  N           MVOG insertion threads (default 1; OctoMap always uses one)\n"
-    "  FRAME       the bag's world frame (default map)\n";
+    "  FRAME       the bag's world frame (default map)\n"
+    "  --clear-conflicting-free-space  MVOG's Sec. V.B option: a scan's free space never\n"
+    "              overlaps its own hits (OctoMap's insertPointCloud does the same per voxel)\n";
 
 double positiveNumber(const std::string& option, const std::string& text) {
   char* end = nullptr;
@@ -60,6 +65,10 @@ Arguments parseArguments(int argc, char** argv) {
   for (int k = 1; k < argc; ++k) {
     const std::string option = argv[k];
     if (option == "--help" || option == "-h") throw UsageError("");
+    if (option == "--clear-conflicting-free-space") {
+      arguments.clear_conflicting_free_space = true;
+      continue;
+    }
     if (k + 1 >= argc) throw UsageError("unknown option or missing value: " + option);
     const std::string value = argv[++k];
     if (option == "--input") {
@@ -104,6 +113,7 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   options.resolution = resolution;
   options.max_range = arguments.max_range;
   options.threads = arguments.threads;
+  options.clear_conflicting_free_space = arguments.clear_conflicting_free_space;
   mvog_bench::ResolutionReport report;
   report.resolution = resolution;
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
@@ -147,6 +157,7 @@ int main(int argc, char** argv) {
     mvog_bench::BenchReport report;
     report.input_path = arguments.input;
     report.max_range = arguments.max_range;
+    report.clear_conflicting_free_space = arguments.clear_conflicting_free_space;
     const auto start = std::chrono::steady_clock::now();
     const mvog_bench::InputData input =
         mvog_bench::loadInput(arguments.input, arguments.fixed_frame);

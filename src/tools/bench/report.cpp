@@ -43,6 +43,7 @@ class JsonObject {
     return raw(key, std::to_string(value));
   }
   JsonObject& add(const std::string& key, int value) { return raw(key, std::to_string(value)); }
+  JsonObject& add(const std::string& key, bool value) { return raw(key, value ? "true" : "false"); }
   JsonObject& add(const std::string& key, const std::string& value) {
     return raw(key, quote(value));
   }
@@ -182,10 +183,12 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                input.skipped_beams, input.non_finite_points, input.without_transform,
                input.invalid_messages);
   if (std::isfinite(report.max_range)) {
-    std::fprintf(out, "max range   %.2f m\n\n", report.max_range);
+    std::fprintf(out, "max range   %.2f m\n", report.max_range);
   } else {
-    std::fprintf(out, "max range   none\n\n");
+    std::fprintf(out, "max range   none\n");
   }
+  std::fprintf(out, "MVOG        clear_conflicting_free_space %s\n\n",
+               report.clear_conflicting_free_space ? "on (Sec. V.B)" : "off (as in the paper)");
 
   std::fprintf(out, "%-8s %7s %7s %10s %10s %12s %14s %14s %14s\n", "backend", "res (m)", "threads",
                "readings", "insert (s)", "readings/s", "memory (B)", "file (B)", ".ot file (B)");
@@ -286,6 +289,7 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
   document.add("results", results)
       .add("input", input_json)
       .add("max_range", report.max_range)
+      .add("clear_conflicting_free_space", report.clear_conflicting_free_space)
       .add("table_one", table_one)
       .add("comparison", comparison)
       .add("agreement", agreement);

@@ -23,6 +23,7 @@ struct BenchReport {
   std::string input_path;
   double load_seconds = 0.0;
   double max_range = 0.0;  ///< infinity: none
+  bool clear_conflicting_free_space = false;
   std::vector<ResolutionReport> resolutions;
 };
 
