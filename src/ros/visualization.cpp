@@ -172,7 +172,7 @@ mvog::CellRange IncrementalGrid::update(const mvog::Map& map,
                                         bool& relaid_out) {
   relaid_out = false;
   const mvog::CellRange bounds = map.bounds();
-  if (bounds.empty()) return {{0, 0}, {-1, -1}};
+  if (bounds.empty()) return kNoCells;
   if (cells_.empty() || !cells_.contains(bounds.min) || !cells_.contains(bounds.max)) {
     // Re-lay out over whole tiles around the bounds plus a margin, and evaluate it all.
     const mvog::TileIndex low = mvog::Map::tileOf(bounds.min);
@@ -191,7 +191,7 @@ mvog::CellRange IncrementalGrid::update(const mvog::Map& map,
     relaid_out = true;
     return cells_;
   }
-  mvog::CellRange touched{{0, 0}, {-1, -1}};
+  mvog::CellRange touched = kNoCells;
   for (const mvog::TileIndex& tile : changed) {
     const mvog::CellRange cells = mvog::Map::tileCells(tile);
     write(cells, compute_(map, cells));
@@ -207,13 +207,14 @@ mvog::CellRange IncrementalGrid::update(const mvog::Map& map,
 
 void IncrementalGrid::write(const mvog::CellRange& cells,
                             const nav_msgs::OccupancyGrid::_data_type& values) {
-  const auto width = static_cast<std::size_t>(cells.width());
   for (std::int64_t row = 0; row < cells.height(); ++row) {
-    const std::size_t target = static_cast<std::size_t>(
-        (cells.min.y + row - cells_.min.y) * cells_.width() + (cells.min.x - cells_.min.x));
-    std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(row) * width),
-                width, grid_.data.begin() + static_cast<std::ptrdiff_t>(target));
+    std::copy_n(values.begin() + row * cells.width(), cells.width(),
+                grid_.data.begin() + indexOf(cells.min.x, cells.min.y + row));
   }
+}
+
+std::ptrdiff_t IncrementalGrid::indexOf(std::int64_t x, std::int64_t y) const {
+  return (y - cells_.min.y) * cells_.width() + (x - cells_.min.x);
 }
 
 map_msgs::OccupancyGridUpdate IncrementalGrid::updateOf(const mvog::CellRange& cells) const {
@@ -225,9 +226,7 @@ map_msgs::OccupancyGridUpdate IncrementalGrid::updateOf(const mvog::CellRange& c
   update.height = static_cast<std::uint32_t>(cells.height());
   update.data.reserve(static_cast<std::size_t>(cells.width() * cells.height()));
   for (std::int64_t row = 0; row < cells.height(); ++row) {
-    const auto start = grid_.data.begin() +
-                       static_cast<std::ptrdiff_t>((cells.min.y + row - cells_.min.y) * cells_.width() +
-                                                   (cells.min.x - cells_.min.x));
+    const auto start = grid_.data.begin() + indexOf(cells.min.x, cells.min.y + row);
     update.data.insert(update.data.end(), start, start + cells.width());
   }
   return update;

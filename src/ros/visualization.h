@@ -53,7 +53,11 @@ class IncrementalGrid {
   /// rectangle that changed (for an OccupancyGridUpdate), or the whole grid after a re-layout.
   mvog::CellRange update(const mvog::Map& map, const std::vector<mvog::TileIndex>& changed,
                          bool& relaid_out);
-  void clear() { grid_ = nav_msgs::OccupancyGrid(); }
+  /// Forgets the grid and its layout: the next update lays it out afresh.
+  void clear() {
+    grid_ = nav_msgs::OccupancyGrid();
+    cells_ = kNoCells;
+  }
   const nav_msgs::OccupancyGrid& grid() const { return grid_; }
   /// The part of the grid over `cells` as an update message.
   map_msgs::OccupancyGridUpdate updateOf(const mvog::CellRange& cells) const;
@@ -61,11 +65,15 @@ class IncrementalGrid {
 
  private:
   void write(const mvog::CellRange& cells, const nav_msgs::OccupancyGrid::_data_type& values);
+  /// Index in the grid's data of cell (x, y).
+  std::ptrdiff_t indexOf(std::int64_t x, std::int64_t y) const;
 
   double z_;
   Compute compute_;
   nav_msgs::OccupancyGrid grid_;
-  mvog::CellRange cells_{{0, 0}, {-1, -1}};
+  static constexpr mvog::CellRange kNoCells{{0, 0}, {-1, -1}};
+
+  mvog::CellRange cells_ = kNoCells;
 };
 
 }  // namespace mvog_ros
