@@ -5,8 +5,12 @@
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "mvog_mapper");
+  // Held until main returns: when the last NodeHandle goes, roscpp shuts down, logging with it,
+  // and a refusal to start would go unreported.
+  ros::NodeHandle nh;
+  ros::NodeHandle private_nh("~");
   try {
-    mvog_ros::Mapper mapper(ros::NodeHandle(), ros::NodeHandle("~"));
+    mvog_ros::Mapper mapper(nh, private_nh);
     ros::AsyncSpinner spinner(4);  // queries and publication beside the sensor callbacks
     spinner.start();
     ros::waitForShutdown();
