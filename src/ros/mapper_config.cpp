@@ -45,6 +45,25 @@ void read(const ros::NodeHandle& nh, const std::string& name, T& value) {
   }
 }
 
+void read(const ros::NodeHandle& nh, const std::string& name, int& value) {
+  if (!nh.hasParam(name)) return;
+  // roscpp's getParam(int) would round a float silently: accept only whole numbers.
+  XmlRpc::XmlRpcValue raw;
+  nh.getParam(name, raw);
+  if (raw.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+    value = static_cast<int>(raw);
+    return;
+  }
+  if (raw.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+    const double number = static_cast<double>(raw);
+    if (std::trunc(number) == number && std::fabs(number) <= std::numeric_limits<int>::max()) {
+      value = static_cast<int>(number);
+      return;
+    }
+  }
+  throw mvog::ConfigError("~" + name + ": must be an integer");
+}
+
 void read(const ros::NodeHandle& nh, const std::string& name, double& value) {
   if (!nh.hasParam(name)) return;
   // Accept integers and floats alike (YAML writes 1 for 1.0).
