@@ -106,21 +106,23 @@ mvog::Scan cloudToReadings(const sensor_msgs::PointCloud2& cloud,
   for (std::uint32_t row = 0; row < cloud.height; ++row) {
     const std::uint8_t* point = cloud.data.data() + std::size_t{row} * cloud.row_step;
     for (std::uint32_t column = 0; column < cloud.width; ++column, point += cloud.point_step) {
-      const Eigen::Vector3d p(readCoordinate(point + fields[0]->offset, fields[0]->datatype, swap_bytes),
-                              readCoordinate(point + fields[1]->offset, fields[1]->datatype, swap_bytes),
-                              readCoordinate(point + fields[2]->offset, fields[2]->datatype, swap_bytes));
+      Eigen::Vector3d p;
+      for (int axis = 0; axis < 3; ++axis) {
+        p[axis] = readCoordinate(point + fields[axis]->offset, fields[axis]->datatype, swap_bytes);
+      }
       readings.hits.push_back((map_from_sensor * p).cast<float>());
     }
   }
   return readings;
 }
 
-void voxelFilter(std::vector<Eigen::Vector3f>& points, double leaf_size) {
+std::size_t voxelFilter(std::vector<Eigen::Vector3f>& points, double leaf_size) {
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
   cloud->reserve(points.size());
   for (const Eigen::Vector3f& p : points) {
     if (p.allFinite()) cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
   }
+  const std::size_t non_finite = points.size() - cloud->size();
   pcl::VoxelGrid<pcl::PointXYZ> filter;
   filter.setInputCloud(cloud);
   const auto leaf = static_cast<float>(leaf_size);
@@ -129,6 +131,7 @@ void voxelFilter(std::vector<Eigen::Vector3f>& points, double leaf_size) {
   filter.filter(filtered);
   points.clear();
   for (const pcl::PointXYZ& p : filtered) points.emplace_back(p.x, p.y, p.z);
+  return non_finite;
 }
 
 }  // namespace mvog_ros

@@ -37,6 +37,7 @@ mvog::Scan cloudToReadings(const sensor_msgs::PointCloud2& cloud,
                            const Eigen::Isometry3d& map_from_sensor, std::size_t max_points);
 
 /// Keeps one point per voxel of edge `leaf_size` (the centroid of its points), with PCL.
-void voxelFilter(std::vector<Eigen::Vector3f>& points, double leaf_size);
+/// Non-finite points are dropped: returns how many.
+std::size_t voxelFilter(std::vector<Eigen::Vector3f>& points, double leaf_size);
 
 }  // namespace mvog_ros

@@ -202,7 +202,7 @@ void Mapper::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud) {
                         static_cast<std::size_t>(config_.max_points_per_message)),
         "PointCloud2"};
     if (config_.voxel_filter_size > 0.0) {
-      voxelFilter(pending.scan.hits, config_.voxel_filter_size);
+      counters_.readings_rejected += voxelFilter(pending.scan.hits, config_.voxel_filter_size);
     }
     enqueue(std::move(pending));
   } catch (const InvalidMessage& e) {

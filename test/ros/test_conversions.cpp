@@ -2,6 +2,7 @@
 // layout, the sensor pose, and the refusal of every malformed message.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -354,6 +355,22 @@ TEST(CloudToReadings, RefusesEveryMalformedCloud) {
   expectRefused(cloud, "2^40 points with short data", std::size_t{1} << 41);
   expectRefused(valid, "more points than the maximum", 5);
   EXPECT_NO_THROW(cloudToReadings(valid, Eigen::Isometry3d::Identity(), 6));
+}
+
+// ---- Voxel filter ----------------------------------------------------------------------------
+
+TEST(VoxelFilter, KeepsOneCentroidPerVoxelAndCountsTheNonFinitePointsItDrops) {
+  std::vector<Eigen::Vector3f> points = {{0.01f, 0.01f, 0.01f},
+                                         {0.03f, 0.05f, 0.07f},
+                                         {kNaN, 0.0f, 0.0f},
+                                         {2.05f, 0.05f, 0.05f},
+                                         {0.0f, kInf, 0.0f}};
+  EXPECT_EQ(voxelFilter(points, 0.1), 2u);
+  ASSERT_EQ(points.size(), 2u);
+  std::sort(points.begin(), points.end(),
+            [](const Eigen::Vector3f& a, const Eigen::Vector3f& b) { return a.x() < b.x(); });
+  expectNear(points[0], {0.02, 0.03, 0.04});
+  expectNear(points[1], {2.05, 0.05, 0.05});
 }
 
 }  // namespace
