@@ -16,14 +16,23 @@ namespace {
 
 constexpr double kWarningPeriod = 5.0;  // s between two warnings of one kind
 
-/// The map a server starts with: ~map_file if set, else an empty one.
+/// Creates ~map_directory if missing and returns the map a server starts with: ~map_file if set,
+/// else an empty one. Throws mvog::ConfigError naming the parameter at fault.
 mvog::Map initialMap(const MapperConfig& config) {
+  try {
+    makeDirectories(config.map_directory);
+  } catch (const PathRefused& e) {
+    throw mvog::ConfigError("~map_directory: " + std::string(e.what()));
+  }
   if (config.map_file.empty()) return mvog::Map(config.map);
-  makeDirectories(config.map_directory);
-  mvog::Map map = mvog::loadMap(resolveMapPath(config.map_directory, config.map_file, false));
-  ROS_INFO("mvog: loaded ~map_file '%s' (resolution %.3f m)", config.map_file.c_str(),
-           map.resolution());
-  return map;
+  try {
+    mvog::Map map = mvog::loadMap(resolveMapPath(config.map_directory, config.map_file, false));
+    ROS_INFO("mvog: loaded ~map_file '%s' (resolution %.3f m)", config.map_file.c_str(),
+             map.resolution());
+    return map;
+  } catch (const std::exception& e) {  // PathRefused or mvog::MapFileError
+    throw mvog::ConfigError("~map_file: " + std::string(e.what()));
+  }
 }
 
 }  // namespace
@@ -42,8 +51,6 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
       config_(MapperConfig::fromParameters(private_nh)),
       map_(initialMap(config_)),
       tf_listener_(tf_buffer_, nh) {
-  makeDirectories(config_.map_directory);
-
   // Outputs. Every one is latched; a new subscriber is also sent the complete current state.
   auto marker_publisher = [&](const std::string& name, bool occupied_only) {
     return private_nh_.advertise<visualization_msgs::MarkerArray>(
@@ -467,8 +474,10 @@ bool Mapper::getCrossSection(mvog::GetCrossSection::Request& request,
     if (!std::isfinite(request.min_x) || !std::isfinite(request.min_y) ||
         !std::isfinite(request.max_x) || !std::isfinite(request.max_y) ||
         request.min_x > request.max_x || request.min_y > request.max_y ||
-        std::fmax(std::fabs(request.min_x), std::fabs(request.max_x)) > config_.map.max_coordinate ||
-        std::fmax(std::fabs(request.min_y), std::fabs(request.max_y)) > config_.map.max_coordinate) {
+        std::fmax(std::fabs(request.min_x), std::fabs(request.max_x)) >
+            config_.map.max_coordinate ||
+        std::fmax(std::fabs(request.min_y), std::fabs(request.max_y)) >
+            config_.map.max_coordinate) {
       response.message = "bounds must be finite, ordered and within ~max_coordinate";
       return true;
     }

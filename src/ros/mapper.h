@@ -35,7 +35,7 @@ namespace mvog_ros {
 /// bounded queue that drops the oldest message when the sensors outpace it.
 class Mapper {
  public:
-  /// Throws mvog::ConfigError (naming the parameter) or mvog::MapFileError (~map_file).
+  /// Throws mvog::ConfigError naming the parameter at fault (~map_file if it cannot be loaded).
   Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh);
   ~Mapper();
   Mapper(const Mapper&) = delete;
