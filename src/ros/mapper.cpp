@@ -1,5 +1,6 @@
 #include "mapper.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -422,7 +423,19 @@ void Mapper::restartPublication() {
   clear.markers.push_back(deleteAllMarker(config_.frame_id, stamp));
   volumes_publisher_.publish(clear);
   occupied_publisher_.publish(clear);
-  for (IncrementalGrid& grid : grids_) grid.clear();
+  // The latched grids would show the previous map to every new subscriber: replace them by
+  // unknown ones until the new map has something to show.
+  for (std::size_t k = 0; k < grids_.size(); ++k) {
+    nav_msgs::OccupancyGrid unknown = grids_[k].grid();
+    if (!unknown.data.empty()) {
+      std::fill(unknown.data.begin(), unknown.data.end(), std::int8_t{-1});
+      unknown.header.frame_id = config_.frame_id;
+      unknown.header.stamp = stamp;
+      unknown.info.map_load_time = stamp;
+      grid_publishers_[k].publish(unknown);
+    }
+    grids_[k].clear();
+  }
   published_revision_ = 0;
   binary_revision_ = 0;
 }
@@ -542,6 +555,7 @@ void Mapper::replaceMap(mvog::Map&& map) {
   std::lock_guard<std::mutex> publish_lock(publish_mutex_);
   std::unique_lock<std::shared_mutex> lock(map_mutex_);
   map_ = std::move(map);
+  saved_revision_ = 0;  // revisions of the new map say nothing about the autosaved file
   restartPublication();
 }
 

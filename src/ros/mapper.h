@@ -79,7 +79,8 @@ class Mapper {
   void sendAllMarkers(const ros::SingleSubscriberPublisher& subscriber, bool occupied_only);
   void sendGrid(const ros::SingleSubscriberPublisher& subscriber, std::size_t layer);
   void sendBinaryMap(const ros::SingleSubscriberPublisher& subscriber);
-  /// Forgets every published tile and grid: the next publication starts from scratch.
+  /// Forgets every published tile and grid (clearing the markers and publishing the grids as
+  /// unknown): the next publication starts from scratch.
   void restartPublication();
 
   bool getOccupancy(mvog::GetOccupancy::Request& request, mvog::GetOccupancy::Response& response);
