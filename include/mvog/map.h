@@ -144,8 +144,12 @@ class Map {
   // ---- Decay (Sec. III-E) -----------------------------------------------------------------
 
   /// Multiplies every mass by k_d in (0, 1], in O(1): masses are stored in a unit that a single
-  /// factor converts, so no cell is touched (except a renormalisation by an exact power of two
-  /// every few dozen steps, which keeps the stored floats in range). Probabilities are unchanged.
+  /// factor converts, so no cell is touched. A cell's stored masses are rescaled, exactly by a
+  /// power of two, only when the cell next receives a volume. Hence the probabilities of a cell
+  /// that receives no new reading stay bit for bit the same after any number of steps; in a
+  /// cell that does, masses decayed below float range relative to the new ones become 0. Masses
+  /// and densities read back (cellVolumes, occupancy) underflow to 0 after extreme decay.
+  /// Increases revision() (unless k_d = 1) but marks no tile: no probability changes.
   void decay(double k_d);
 
   // ---- Bookkeeping ------------------------------------------------------------------------
@@ -153,7 +157,8 @@ class Map {
   MemoryUsage memoryUsage() const;
   bool empty() const { return bounds_.empty(); }
   void clear();
-  /// Increases with every change; tilesModifiedSince() lists the tiles changed after a revision.
+  /// Increases with every change; tilesModifiedSince() lists the tiles whose volumes changed
+  /// after a revision (decay, which scales every mass alike, lists none).
   std::uint64_t revision() const { return revision_; }
   std::vector<TileIndex> tilesModifiedSince(std::uint64_t revision) const;
   /// Cells covered by a tile (whether or not they hold volumes).
@@ -162,8 +167,11 @@ class Map {
 
   // ---- Direct access for serialisation ------------------------------------------------------
 
-  /// Replaces a cell's lists. Throws ConfigError unless both lists satisfy the Sec. III-A
-  /// constraints (sorted, heights >= 1, gaps > 1, finite non-negative masses).
+  /// Replaces a cell's lists (masses as cellVolumes returns them). Throws ConfigError unless both
+  /// lists satisfy the Sec. III-A constraints (sorted, heights >= 1, gaps > 1, finite
+  /// non-negative masses, representable in the map's decayed mass unit) and the cell lies within
+  /// max_coordinate (|i|, |j| <= max_coordinate / resolution + 1, the cells readings can reach).
+  /// Emptying a cell removes it from bounds().
   void setCellVolumes(const CellIndex& cell, const CellVolumes& volumes);
 
  private:
@@ -180,14 +188,17 @@ class Map {
                      InsertionResult& result) const;
   template <class T, class CellValue>
   Grid2D<T> fillGrid(const CellRange& cells, T unobserved, CellValue&& value_of) const;
-  float realMass(float stored_mass) const;
-  void growBounds(const CellIndex& cell);
+  double realMass(const Cell& cell, float stored_mass) const;
+  void growBounds(const CellRange& cells);
+  void recomputeBounds();
 
   MapConfig config_;
   double scale_inverse_;  // 1 / resolution
-  /// Stored masses are in units of `mass_unit_` real mass: real = stored * mass_unit_. Decay
-  /// multiplies mass_unit_ only (Sec. III-E in O(1)).
+  /// Stored masses of a cell are in units of mass_unit_ * 2^(unit_exponent_ - the cell's
+  /// exponent) real mass, mass_unit_ in (0.5, 1]. Decay changes these two only (Sec. III-E in
+  /// O(1)); a cell takes the map's unit exponent when it is written.
   double mass_unit_ = 1.0;
+  std::int64_t unit_exponent_ = 0;
   std::unordered_map<std::uint64_t, std::unique_ptr<Tile>> tiles_;
   std::uint64_t revision_ = 1;
   CellRange bounds_{{0, 0}, {-1, -1}};

@@ -21,10 +21,39 @@ std::uint64_t packKey(std::int32_t x, std::int32_t y) {
 /// Readings are cut into chunks so that the buffered volumes of the threaded path stay small.
 constexpr std::size_t kReadingsPerChunk = 8192;
 
+/// Grows `range` to hold `other` too (an empty `other` changes nothing).
+void include(CellRange& range, const CellRange& other) {
+  if (other.empty()) return;
+  if (range.empty()) {
+    range = other;
+    return;
+  }
+  range.min = {std::min(range.min.x, other.min.x), std::min(range.min.y, other.min.y)};
+  range.max = {std::max(range.max.x, other.max.x), std::max(range.max.y, other.max.y)};
+}
+
+/// Splits x > 0 into f * 2^e with f in (0.5, 1] (exactly, subnormal x included).
+double splitPowerOfTwo(double x, int& e) {
+  double f = std::frexp(x, &e);
+  if (f == 0.5) {
+    f = 1.0;
+    --e;
+  }
+  return f;
+}
+
+/// When the map's unit exponent falls below this, the exponents are rebased (see Map::decay);
+/// a cell's exponent is kept within kMaxExponentLag of the map's, which changes nothing that a
+/// double can show: 2^-kMaxExponentLag is zero in double.
+constexpr std::int64_t kMinUnitExponent = -(std::int64_t{1} << 24);
+constexpr std::int64_t kMaxExponentLag = std::int64_t{1} << 24;
+
 }  // namespace
 
 // ---- Cell: one heap block [header | positive volumes | negative volumes] behind one pointer.
-// An unobserved cell costs 8 bytes; the paper's two lists share the block (Sec. III-A).
+// An unobserved cell costs 8 bytes; the paper's two lists share the block (Sec. III-A). The
+// header holds the cell's mass exponent: real mass = stored mass * Map::mass_unit_ *
+// 2^(Map::unit_exponent_ - exponent) (see Map::decay).
 
 class Map::Cell {
  public:
@@ -43,13 +72,24 @@ class Map::Cell {
   }
   bool empty() const { return block_ == nullptr; }
   std::size_t bytes() const { return block_ == nullptr ? 0 : blockBytes(block_->capacity); }
+  std::int32_t exponent() const { return block_ == nullptr ? 0 : block_->exponent; }
 
-  /// Inserts with the constraints applied; returns the change of bytes held.
-  std::ptrdiff_t insert(VolumeSign sign, const Volume& volume, float unit_mass) {
+  /// Inserts `volume`, whose mass is in the unit of the map's current `unit_exponent`, with the
+  /// constraints applied; returns the change of bytes held. The cell's masses are first brought
+  /// to that unit (exactly, by a power of two, unless they underflow).
+  std::ptrdiff_t insert(VolumeSign sign, const Volume& volume, float unit_mass,
+                        std::int64_t unit_exponent) {
     const std::size_t old_bytes = bytes();
-    const std::uint32_t total = block_ == nullptr ? 0 : block_->num_positive + block_->num_negative;
+    const bool fresh = block_ == nullptr;
+    const std::uint32_t total = fresh ? 0 : block_->num_positive + block_->num_negative;
     reserve(total + 1);
     Volume* all = volumes();
+    if (!fresh && block_->exponent != unit_exponent) {
+      // Decay since the last write lowered the unit exponent: unit_exponent < exponent.
+      const auto shift = static_cast<int>(unit_exponent - block_->exponent);
+      for (std::uint32_t k = 0; k < total; ++k) all[k].mass = std::ldexp(all[k].mass, shift);
+    }
+    block_->exponent = static_cast<std::int32_t>(unit_exponent);
     std::uint32_t& num_positive = block_->num_positive;
     std::uint32_t& num_negative = block_->num_negative;
     if (sign == VolumeSign::kNegative) {
@@ -66,14 +106,15 @@ class Map::Cell {
     return static_cast<std::ptrdiff_t>(bytes()) - static_cast<std::ptrdiff_t>(old_bytes);
   }
 
-  /// Replaces both lists; returns the change of bytes held.
-  std::ptrdiff_t assign(const CellVolumes& volumes_in) {
+  /// Replaces both lists, masses in the unit of `unit_exponent`; returns the change of bytes held.
+  std::ptrdiff_t assign(const CellVolumes& volumes_in, std::int64_t unit_exponent) {
     const std::size_t old_bytes = bytes();
     const std::size_t total = volumes_in.positive.size() + volumes_in.negative.size();
     std::free(block_);
     block_ = nullptr;
     if (total > 0) {
       reserve(static_cast<std::uint32_t>(total));
+      block_->exponent = static_cast<std::int32_t>(unit_exponent);
       block_->num_positive = static_cast<std::uint32_t>(volumes_in.positive.size());
       block_->num_negative = static_cast<std::uint32_t>(volumes_in.negative.size());
       std::copy(volumes_in.positive.begin(), volumes_in.positive.end(), volumes());
@@ -83,12 +124,11 @@ class Map::Cell {
     return static_cast<std::ptrdiff_t>(bytes()) - static_cast<std::ptrdiff_t>(old_bytes);
   }
 
-  void scaleMasses(int power_of_two) {
+  /// The map's unit exponent moves up by -unit_exponent (to 0): keep the cell's real masses.
+  void rebaseExponent(std::int64_t unit_exponent) {
     if (block_ == nullptr) return;
-    Volume* all = volumes();
-    for (std::uint32_t k = 0; k < block_->num_positive + block_->num_negative; ++k) {
-      all[k].mass = std::ldexp(all[k].mass, power_of_two);
-    }
+    block_->exponent = static_cast<std::int32_t>(
+        std::min(std::int64_t{block_->exponent} - unit_exponent, kMaxExponentLag));
   }
 
  private:
@@ -96,6 +136,7 @@ class Map::Cell {
     std::uint32_t num_positive;
     std::uint32_t num_negative;
     std::uint32_t capacity;
+    std::int32_t exponent;
   };
   static_assert(alignof(Header) >= alignof(Volume) && sizeof(Header) % alignof(Volume) == 0,
                 "volumes follow the header directly");
@@ -189,13 +230,19 @@ CellRange Map::cellsInRectangle(double min_x, double min_y, double max_x, double
   return {cellAtPoint(min_x, min_y), cellAtPoint(max_x, max_y)};
 }
 
-void Map::growBounds(const CellIndex& cell) {
-  if (bounds_.empty()) {
-    bounds_ = {cell, cell};
-    return;
+void Map::growBounds(const CellRange& cells) { include(bounds_, cells); }
+
+void Map::recomputeBounds() {
+  bounds_ = CellRange{{0, 0}, {-1, -1}};
+  for (const auto& entry : tiles_) {
+    const CellRange tile_cells = tileCells(
+        {static_cast<std::int32_t>(entry.first >> 32), static_cast<std::int32_t>(entry.first)});
+    for (std::int32_t y = tile_cells.min.y; y <= tile_cells.max.y; ++y) {
+      for (std::int32_t x = tile_cells.min.x; x <= tile_cells.max.x; ++x) {
+        if (!entry.second->at({x, y}).empty()) include(bounds_, {{x, y}, {x, y}});
+      }
+    }
   }
-  bounds_.min = {std::min(bounds_.min.x, cell.x), std::min(bounds_.min.y, cell.y)};
-  bounds_.max = {std::max(bounds_.max.x, cell.x), std::max(bounds_.max.y, cell.y)};
 }
 
 bool Map::acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
@@ -282,7 +329,8 @@ void volumesOfReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, 
 
 /// Finds or creates the tiles that a writer touches, remembering the last one: consecutive cells
 /// of a ray mostly share a tile. `created` (if given) receives new tiles instead of the map, so
-/// that several writers can run at once on disjoint tiles (see insertScan).
+/// that several writers can run at once on disjoint tiles (see insertScan). The rectangle of the
+/// cells given volumes is kept for the map's bounds, which hold cells with volumes only.
 class Map::TileWriter {
  public:
   TileWriter(Map& map, std::unordered_map<std::uint64_t, std::unique_ptr<Tile>>* created)
@@ -299,9 +347,11 @@ class Map::TileWriter {
     return last_tile_->at(index);
   }
   void insert(const CellIndex& index, VolumeSign sign, const Volume& volume, float unit_mass) {
-    bytes_added_ += cell(index).insert(sign, volume, unit_mass);
+    bytes_added_ += cell(index).insert(sign, volume, unit_mass, map_.unit_exponent_);
+    include(touched_, {index, index});
   }
   std::ptrdiff_t bytesAdded() const { return bytes_added_; }
+  const CellRange& touched() const { return touched_; }
 
  private:
   Tile* lookup(std::uint64_t key) {
@@ -322,6 +372,7 @@ class Map::TileWriter {
   std::uint64_t last_key_ = 0;
   Tile* last_tile_ = nullptr;
   std::ptrdiff_t bytes_added_ = 0;
+  CellRange touched_{{0, 0}, {-1, -1}};
 };
 
 InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
@@ -332,8 +383,6 @@ InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::V
   bool obstacle = false;
   if (!acceptReading(origin, end, is_obstacle, config, ray_end, obstacle, result)) return result;
   ++revision_;
-  growBounds(cellAtPoint(origin.x(), origin.y()));
-  growBounds(cellAtPoint(ray_end.x(), ray_end.y()));
   const float unit_mass = static_cast<float>(1.0 / mass_unit_);
   TileWriter writer(*this, nullptr);
   volumesOfReading(origin * scale_inverse_, ray_end * scale_inverse_, obstacle,
@@ -342,6 +391,7 @@ InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::V
                      writer.insert(cell, sign, volume, unit_mass);
                    });
   bytes_in_cells_ += writer.bytesAdded();
+  growBounds(writer.touched());
   return result;
 }
 
@@ -358,9 +408,7 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
   auto accept = [&](const Eigen::Vector3f& end, bool is_obstacle) {
     Eigen::Vector3d ray_end;
     bool obstacle = false;
-    if (acceptReading(origin, end.cast<double>(), is_obstacle, config, ray_end, obstacle,
-                      result)) {
-      growBounds(cellAtPoint(ray_end.x(), ray_end.y()));
+    if (acceptReading(origin, end.cast<double>(), is_obstacle, config, ray_end, obstacle, result)) {
       readings.push_back({ray_end * scale_inverse_, obstacle});
     }
   };
@@ -368,7 +416,6 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
   for (const Eigen::Vector3f& end : scan.free_endpoints) accept(end, false);
   if (readings.empty()) return result;
   ++revision_;
-  growBounds(cellAtPoint(origin.x(), origin.y()));
 
   const Eigen::Vector3d start = origin * scale_inverse_;
   const float unit_mass = static_cast<float>(1.0 / mass_unit_);
@@ -397,6 +444,7 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
       });
     }
     bytes_in_cells_ += writer.bytesAdded();
+    growBounds(writer.touched());
     return result;
   }
 
@@ -419,6 +467,7 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
       num_threads, std::vector<std::vector<Contribution>>(num_threads));
   std::vector<std::unordered_map<std::uint64_t, std::unique_ptr<Tile>>> created(num_threads);
   std::vector<std::ptrdiff_t> bytes_added(num_threads, 0);
+  std::vector<CellRange> touched(num_threads, CellRange{{0, 0}, {-1, -1}});
   auto run_parallel = [num_threads](auto&& task) {
     std::vector<std::thread> workers;
     for (std::size_t t = 1; t < num_threads; ++t) workers.emplace_back(task, t);
@@ -446,6 +495,7 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
         }
       }
       bytes_added[owner] += writer.bytesAdded();
+      include(touched[owner], writer.touched());
     });
     for (auto& tiles : created) {
       for (auto& entry : tiles) tiles_.emplace(entry.first, std::move(entry.second));
@@ -453,6 +503,7 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
     }
   }
   for (std::ptrdiff_t bytes : bytes_added) bytes_in_cells_ += bytes;
+  for (const CellRange& cells : touched) growBounds(cells);
   return result;
 }
 
@@ -482,14 +533,14 @@ PointOccupancy Map::occupancy(const Eigen::Vector3d& point) const {
       findVolume(cell->list(VolumeSign::kPositive), cell->count(VolumeSign::kPositive), z);
   const Volume* negative =
       findVolume(cell->list(VolumeSign::kNegative), cell->count(VolumeSign::kNegative), z);
-  if (positive != nullptr) result.positive_density = positive->density() * mass_unit_;
-  if (negative != nullptr) result.negative_density = negative->density() * mass_unit_;
+  if (positive != nullptr) result.positive_density = realMass(*cell, positive->density());
+  if (negative != nullptr) result.negative_density = realMass(*cell, negative->density());
   result.probability = probabilityOf(positive, negative);
   return result;
 }
 
-float Map::realMass(float stored_mass) const {
-  return static_cast<float>(stored_mass * mass_unit_);
+double Map::realMass(const Cell& cell, float stored_mass) const {
+  return std::ldexp(stored_mass * mass_unit_, static_cast<int>(unit_exponent_ - cell.exponent()));
 }
 
 CellVolumes Map::cellVolumes(const CellIndex& index) const {
@@ -500,7 +551,8 @@ CellVolumes Map::cellVolumes(const CellIndex& index) const {
     std::vector<Volume>& out = sign == VolumeSign::kPositive ? result.positive : result.negative;
     const Volume* list = cell->list(sign);
     for (std::uint32_t k = 0; k < cell->count(sign); ++k) {
-      out.push_back({list[k].bottom, list[k].top, realMass(list[k].mass)});
+      out.push_back(
+          {list[k].bottom, list[k].top, static_cast<float>(realMass(*cell, list[k].mass))});
     }
   }
   return result;
@@ -631,7 +683,8 @@ void Map::forEachVolumeIn(
         for (VolumeSign sign : {VolumeSign::kPositive, VolumeSign::kNegative}) {
           const Volume* list = cell.list(sign);
           for (std::uint32_t k = 0; k < cell.count(sign); ++k) {
-            visit(index, sign, Volume{list[k].bottom, list[k].top, realMass(list[k].mass)});
+            const auto mass = static_cast<float>(realMass(cell, list[k].mass));
+            visit(index, sign, Volume{list[k].bottom, list[k].top, mass});
           }
         }
       }
@@ -648,16 +701,22 @@ void Map::forEachVolume(
 
 void Map::decay(double k_d) {
   if (!(k_d > 0.0 && k_d <= 1.0)) throw ConfigError("k_d: must be in (0, 1]");
-  mass_unit_ *= k_d;
-  // Keep stored masses (real / unit) far from float overflow: once the unit falls below 2^-64,
-  // fold its binary exponent into every stored mass. Multiplying by a power of two is exact, so
-  // no probability changes.
-  if (mass_unit_ < 0x1p-64) {
-    const int exponent = std::ilogb(mass_unit_);
+  if (k_d == 1.0) return;
+  ++revision_;  // every mass changes; no probability does, so no tile is marked
+  // mass_unit_ * 2^unit_exponent_ *= k_d, with mass_unit_ kept in (0.5, 1]: no cell is touched,
+  // and the unit exponent never rises (k_d <= 1).
+  int k_exponent = 0;
+  const double k_fraction = splitPowerOfTwo(k_d, k_exponent);
+  int unit_exponent = 0;
+  mass_unit_ = splitPowerOfTwo(mass_unit_ * k_fraction, unit_exponent);
+  unit_exponent_ += k_exponent + unit_exponent;
+  // After some 2^24 binary orders of decay, move the exponents back near zero so that they stay
+  // within 32 bits. No real mass changes that a double can show, and no stored mass changes.
+  if (unit_exponent_ < kMinUnitExponent) {
     for (auto& entry : tiles_) {
-      for (Cell& cell : entry.second->cells) cell.scaleMasses(exponent);
+      for (Cell& cell : entry.second->cells) cell.rebaseExponent(unit_exponent_);
     }
-    mass_unit_ = std::ldexp(mass_unit_, -exponent);
+    unit_exponent_ = 0;
   }
 }
 
@@ -687,6 +746,7 @@ void Map::clear() {
   bounds_ = CellRange{{0, 0}, {-1, -1}};
   bytes_in_cells_ = 0;
   mass_unit_ = 1.0;
+  unit_exponent_ = 0;
   ++revision_;
 }
 
@@ -701,23 +761,37 @@ std::vector<TileIndex> Map::tilesModifiedSince(std::uint64_t revision) const {
 }
 
 void Map::setCellVolumes(const CellIndex& index, const CellVolumes& volumes) {
-  for (VolumeSign sign : {VolumeSign::kPositive, VolumeSign::kNegative}) {
-    const std::vector<Volume>& list =
-        sign == VolumeSign::kPositive ? volumes.positive : volumes.negative;
-    const std::string problem = checkVolumeList(list.data(), list.size());
-    if (!problem.empty()) {
-      throw ConfigError(std::string(sign == VolumeSign::kPositive ? "positive" : "negative") +
-                        " volumes: " + problem);
-    }
+  // Readings within max_coordinate fall in cells |i|, |j| <= max_coordinate * s + 1.
+  const double max_cell = config_.max_coordinate * scale_inverse_ + 1.0;
+  if (std::fabs(static_cast<double>(index.x)) > max_cell ||
+      std::fabs(static_cast<double>(index.y)) > max_cell) {
+    throw ConfigError("cell: (" + std::to_string(index.x) + ", " + std::to_string(index.y) +
+                      ") lies beyond max_coordinate");
   }
   CellVolumes stored = volumes;
-  for (std::vector<Volume>* list : {&stored.positive, &stored.negative}) {
-    for (Volume& v : *list) v.mass = static_cast<float>(v.mass / mass_unit_);
+  for (VolumeSign sign : {VolumeSign::kPositive, VolumeSign::kNegative}) {
+    std::vector<Volume>& list = sign == VolumeSign::kPositive ? stored.positive : stored.negative;
+    const char* name = sign == VolumeSign::kPositive ? "positive volumes: " : "negative volumes: ";
+    const std::string problem = checkVolumeList(list.data(), list.size());
+    if (!problem.empty()) throw ConfigError(name + problem);
+    for (Volume& v : list) {
+      v.mass = static_cast<float>(v.mass / mass_unit_);
+      if (!std::isfinite(v.mass)) {
+        throw ConfigError(std::string(name) + "a mass is too large for the map's decayed unit");
+      }
+    }
   }
+  const bool now_empty = stored.positive.empty() && stored.negative.empty();
+  const Cell* existing = findCell(index);
+  if (now_empty && (existing == nullptr || existing->empty())) return;  // nothing changes
   ++revision_;
   TileWriter writer(*this, nullptr);
-  bytes_in_cells_ += writer.cell(index).assign(stored);
-  if (!stored.positive.empty() || !stored.negative.empty()) growBounds(index);
+  bytes_in_cells_ += writer.cell(index).assign(stored, unit_exponent_);
+  if (now_empty) {
+    recomputeBounds();
+  } else {
+    growBounds({index, index});
+  }
 }
 
 }  // namespace mvog

@@ -182,7 +182,6 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   Reader reader(data, kMapHeaderBytes);
   std::unordered_set<std::uint64_t> seen;
   std::uint64_t volumes_read = 0;
-  const double max_cell = config.max_coordinate / config.resolution + 1.0;
   for (std::uint64_t c = 0; c < cell_count; ++c) {
     const CellIndex cell{reader.i32(), reader.i32()};
     const std::uint64_t num_positive = reader.u32();
@@ -191,10 +190,6 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     if (num_positive + num_negative == 0) fail(where + " holds no volume");
     if (volumes_read + num_positive + num_negative > volume_count) {
       fail(where + " holds more volumes than the header counts");
-    }
-    if (std::fabs(static_cast<double>(cell.x)) > max_cell ||
-        std::fabs(static_cast<double>(cell.y)) > max_cell) {
-      fail(where + " lies beyond max_coordinate");
     }
     const std::uint64_t key =
         (std::uint64_t{static_cast<std::uint32_t>(cell.x)} << 32) | static_cast<std::uint32_t>(cell.y);
@@ -207,7 +202,7 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     }
     volumes_read += num_positive + num_negative;
     try {
-      map.setCellVolumes(cell, volumes);
+      map.setCellVolumes(cell, volumes);  // checks the constraints and max_coordinate
     } catch (const ConfigError& e) {
       fail(where + ": " + e.what());
     }
