@@ -138,6 +138,28 @@ TEST(Decay, LongDecayedReadingsGiveWayToNewOnes) {
   EXPECT_TRUE(test::volumeIs(fresh.positive[0], 4.5, 5.5, 1.0));
 }
 
+TEST(Decay, SurvivesDecayBeyondAnyExponentRange) {
+  // 20000 steps of the smallest positive double: some 2^24.4 binary orders of decay, beyond what
+  // 32-bit exponents hold without rebasing. Probabilities stay bit for bit; readings added in the
+  // middle and at the end get the masses of fresh readings.
+  Map map = randomMap(10);
+  const std::vector<std::uint32_t> before = probe(map);
+  constexpr double kTiny = std::numeric_limits<double>::denorm_min();
+  for (int step = 0; step < 10000; ++step) map.decay(kTiny);
+  map.insertReading({30.5, 0.5, 0}, {30.5, 0.5, 1}, true);
+  for (int step = 0; step < 10000; ++step) map.decay(kTiny);
+  EXPECT_TRUE(test::sameProbabilities(probe(map), before));
+  map.insertReading({30.5, 0.5, 0}, {30.5, 0.5, 1}, true);
+  const CellVolumes cell = map.cellVolumes(map.cellAtPoint(30.5, 0.5));
+  // s = 5: V = [4.5, 5.5] and V' = [0, 4.5] in grid units; the first reading's masses, decayed
+  // by 2^-(2^23.4) since, vanished in the merge.
+  ASSERT_EQ(cell.positive.size(), 1u);
+  ASSERT_EQ(cell.negative.size(), 1u);
+  EXPECT_TRUE(test::volumeIs(cell.positive[0], 4.5, 5.5, 1.0));
+  EXPECT_TRUE(test::volumeIs(cell.negative[0], 0.0, 4.5, 4.5));
+  EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+}
+
 TEST(Decay, RefusesFactorsOutsideZeroOne) {
   Map map = randomMap(5);
   const std::vector<test::VolumeRecord> before = allVolumes(map);
@@ -276,6 +298,39 @@ TEST(Map, SetCellVolumesRefusesListsBreakingTheConstraints) {
   }
   EXPECT_TRUE(map.empty());
   EXPECT_TRUE(allVolumes(map).empty());
+}
+
+TEST(Map, SetCellVolumesRefusesCellsBeyondMaxCoordinate) {
+  Map map(unitConfig(100.0));  // readings reach cells -101..100
+  const CellVolumes volumes{{{0, 1, 1}}, {}};
+  EXPECT_NO_THROW(map.setCellVolumes({-101, 101}, volumes));
+  for (const CellIndex& cell : {CellIndex{102, 0}, CellIndex{0, -102},
+                                CellIndex{std::numeric_limits<std::int32_t>::min(), 0}}) {
+    try {
+      map.setCellVolumes(cell, volumes);
+      ADD_FAILURE() << "accepted (" << cell.x << ", " << cell.y << ")";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("cell"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(allVolumes(map).size(), 1u);
+}
+
+TEST(Map, SetCellVolumesOnADecayedMapKeepsTheGivenMasses) {
+  Map map(unitConfig());
+  map.decay(0.3);
+  map.setCellVolumes({1, 2}, CellVolumes{{{0, 2, 3}}, {{-4, -1, 0.25f}}});
+  const CellVolumes cell = map.cellVolumes({1, 2});
+  EXPECT_FLOAT_EQ(cell.positive.at(0).mass, 3.0f);
+  EXPECT_FLOAT_EQ(cell.negative.at(0).mass, 0.25f);
+  EXPECT_NEAR(map.occupancy({1.5, 2.5, 1.0}).positive_density, 1.5, 1e-6);
+  // A new reading there merges at its own real mass: [0.5, 1.5] (mass 1) into [0, 2] (mass 3).
+  map.insertReading({1.5, 2.5, 1.0}, {1.6, 2.6, 1.0}, true);
+  EXPECT_FLOAT_EQ(map.cellVolumes({1, 2}).positive.at(0).mass, 4.0f);
+  // Masses beyond float range in the decayed unit are refused, the map unchanged.
+  const float huge = std::numeric_limits<float>::max();
+  EXPECT_THROW(map.setCellVolumes({1, 2}, CellVolumes{{{0, 2, huge}}, {}}), ConfigError);
+  EXPECT_FLOAT_EQ(map.cellVolumes({1, 2}).positive.at(0).mass, 4.0f);
 }
 
 TEST(Map, SetCellVolumesReplacesAndEmptiesCells) {
@@ -477,14 +532,30 @@ TEST(ChangeTracking, TilesTouchedByAnInsertionAreListed) {
   EXPECT_EQ(modifiedSince(map, r2), (std::vector<std::pair<int, int>>{{-2, 4}}));
 }
 
+TEST(ChangeTracking, DecayIsAChangeOfNoTile) {
+  // Decay changes every mass (what cellVolumes and serializeMap return), so the revision moves;
+  // no probability changes, so no tile is listed. A factor of 1 changes nothing.
+  Map map(unitConfig());
+  map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, true);
+  const std::uint64_t r0 = map.revision();
+  map.decay(1.0);
+  EXPECT_EQ(map.revision(), r0);
+  map.decay(0.5);
+  EXPECT_GT(map.revision(), r0);
+  EXPECT_TRUE(modifiedSince(map, r0).empty());
+}
+
 TEST(ChangeTracking, ListsExactlyTheTilesWhoseCellsChanged) {
+  // Single readings, and scans with one thread and with three (new and existing tiles alike).
   Map map(unitConfig());
   std::mt19937 rng(9);
-  for (int k = 0; k < 30; ++k) {
+  for (int k = 0; k < 45; ++k) {
     const std::vector<test::VolumeRecord> before = allVolumes(map);
     const std::uint64_t revision = map.revision();
     if (k % 3 == 0) {
-      map.insertScan(test::randomScan(rng, test::randomPoint(rng, 40.0, 1.0), 3, 2, 60.0));
+      InsertionConfig config;
+      config.num_threads = k % 2 == 0 ? 1 : 3;
+      map.insertScan(test::randomScan(rng, test::randomPoint(rng, 40.0, 1.0), 6, 3, 60.0), config);
     } else {
       map.insertReading(test::randomPoint(rng, 60.0, 1.0), test::randomPoint(rng, 60.0, 1.0),
                         k % 2 == 0);

@@ -290,6 +290,8 @@ TEST(Projection, OccupiedFreeOrUnknownPerCell) {
   EXPECT_EQ(
       projectRow(map, 0.0, 1.5, 0.5),
       (std::vector<OccupancyState>{kOcc, kFree, kFree, kFree, kUnk, kUnk, kUnk, kOcc, kFree}));
+  // Occupied only where p > threshold: p = 0.25 at a threshold of 0.25 is free.
+  EXPECT_EQ(projectRow(map, 0.0, 1.5, 0.25)[2], kFree);
   // A lower threshold: p = 0.25 > 0.2 is occupied.
   EXPECT_EQ(projectRow(map, 0.0, 1.5, 0.2),
             (std::vector<OccupancyState>{kOcc, kFree, kOcc, kOcc, kUnk, kUnk, kUnk, kOcc, kFree}));

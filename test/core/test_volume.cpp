@@ -177,8 +177,12 @@ TEST(InsertVolume, GapBelowOneMergesAndAddsTheGapMass) {
 }
 
 TEST(InsertVolume, GapOfExactlyOneMerges) {
-  // z_B^bot - z_A^top = 1 lies in (0, 1]: merge, m = 1 + 1 + 1 = 3.
-  const std::vector<Volume> list = inserted({fresh(0.0f, 1.0f)}, fresh(2.0f, 3.0f));
+  // z_B^bot - z_A^top = 1 lies in (0, 1]: merge, m = 1 + 1 + 1 = 3, the new volume above...
+  std::vector<Volume> list = inserted({fresh(0.0f, 1.0f)}, fresh(2.0f, 3.0f));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_TRUE(volumeIs(list[0], 0.0, 3.0, 3.0));
+  // ...or below.
+  list = inserted({fresh(2.0f, 3.0f)}, fresh(0.0f, 1.0f));
   ASSERT_EQ(list.size(), 1u);
   EXPECT_TRUE(volumeIs(list[0], 0.0, 3.0, 3.0));
 }
