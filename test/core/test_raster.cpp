@@ -260,7 +260,7 @@ TEST(WalkRay, LongRay) {
   EXPECT_EQ(steps.size(), 5000u + 3001u + 1u);  // no corner is hit exactly on this ray
 }
 
-TEST(Map, ZeroLengthReadingsAreDroppedAsTooClose) {
+TEST(Insertion, ZeroLengthReadingsAreDroppedAsTooClose) {
   Map map(test::unitConfig());
   const Eigen::Vector3d p(1.5, -2.5, 0.5);
   for (bool is_obstacle : {true, false}) {
