@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -31,7 +33,18 @@ constexpr float kMaxMergeGap = 1.0f;
 /// Eq. (6): the volume spanning [z_a, z_b] (either order) with the minimum height enforced around
 /// its centre. The mass is that of density 1 over the final height, times `unit_mass` (the map's
 /// stored-mass unit, see Map::decay): every new volume starts at density 1 (Sec. III-B.2).
-Volume makeVolume(float z_a, float z_b, float unit_mass);
+inline Volume makeVolume(float z_a, float z_b, float unit_mass) {
+  Volume volume{std::min(z_a, z_b), std::max(z_a, z_b), 0.0f};
+  if (volume.height() < kMinVolumeHeight) {
+    const float centre = 0.5f * (volume.bottom + volume.top);  // eq. (6)
+    volume.bottom = centre - 0.5f * kMinVolumeHeight;
+    volume.top = centre + 0.5f * kMinVolumeHeight;
+    // The float sum may round to just under the minimum height; nudge the top up to it.
+    while (volume.height() < kMinVolumeHeight) volume.top = std::nextafter(volume.top, INFINITY);
+  }
+  volume.mass = volume.height() * unit_mass;
+  return volume;
+}
 
 /// Inserts `volume` into the sorted list `list[0, count)` (which satisfies the Sec. III-A
 /// constraints) and restores the constraints: volumes that overlap it (eq. 7) or lie within a gap

@@ -18,9 +18,6 @@ std::uint64_t packKey(std::int32_t x, std::int32_t y) {
   return (std::uint64_t{static_cast<std::uint32_t>(x)} << 32) | static_cast<std::uint32_t>(y);
 }
 
-/// Readings are cut into chunks so that the buffered volumes of the threaded path stay small.
-constexpr std::size_t kReadingsPerChunk = 8192;
-
 /// Grows `range` to hold `other` too (an empty `other` changes nothing).
 void include(CellRange& range, const CellRange& other) {
   if (other.empty()) return;
@@ -79,10 +76,9 @@ class Map::Cell {
   /// to that unit (exactly, by a power of two, unless they underflow).
   std::ptrdiff_t insert(VolumeSign sign, const Volume& volume, float unit_mass,
                         std::int64_t unit_exponent) {
-    const std::size_t old_bytes = bytes();
     const bool fresh = block_ == nullptr;
     const std::uint32_t total = fresh ? 0 : block_->num_positive + block_->num_negative;
-    reserve(total + 1);
+    const std::ptrdiff_t bytes_added = reserve(total + 1);
     Volume* all = volumes();
     if (!fresh && block_->exponent != unit_exponent) {
       // Decay since the last write lowered the unit exponent: unit_exponent < exponent.
@@ -103,7 +99,7 @@ class Map::Cell {
       }
       num_positive = count;
     }
-    return static_cast<std::ptrdiff_t>(bytes()) - static_cast<std::ptrdiff_t>(old_bytes);
+    return bytes_added;
   }
 
   /// Replaces both lists, masses in the unit of `unit_exponent`; returns the change of bytes held.
@@ -146,17 +142,24 @@ class Map::Cell {
   }
   Volume* volumes() const { return reinterpret_cast<Volume*>(block_ + 1); }
 
-  void reserve(std::uint32_t needed) {
+  /// Makes room for `needed` volumes; returns the change of bytes held.
+  std::ptrdiff_t reserve(std::uint32_t needed) {
     const std::uint32_t capacity = block_ == nullptr ? 0 : block_->capacity;
-    if (needed <= capacity) return;
-    // Most columns hold a handful of volumes: grow by two, then by half, to keep slack small.
-    const std::uint32_t grown = std::max(needed, capacity < 4 ? capacity + 2 : capacity + capacity / 2);
+    if (needed <= capacity) return 0;
+    // Most columns hold a handful of volumes: grow one at a time, then by half, so that spare
+    // capacity stays small.
+    const std::uint32_t grown =
+        std::max(needed, capacity < 4 ? capacity + 1 : capacity + capacity / 2);
+    const std::size_t old_bytes = bytes();
     void* block = std::realloc(block_, blockBytes(grown));
     if (block == nullptr) throw std::bad_alloc();
-    if (block_ == nullptr) static_cast<Header*>(block)->num_positive = 0;
-    if (block_ == nullptr) static_cast<Header*>(block)->num_negative = 0;
+    if (block_ == nullptr) {
+      static_cast<Header*>(block)->num_positive = 0;
+      static_cast<Header*>(block)->num_negative = 0;
+    }
     block_ = static_cast<Header*>(block);
     block_->capacity = grown;
+    return static_cast<std::ptrdiff_t>(blockBytes(grown)) - static_cast<std::ptrdiff_t>(old_bytes);
   }
 
   Header* block_ = nullptr;
@@ -245,9 +248,8 @@ void Map::recomputeBounds() {
   }
 }
 
-bool Map::acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
-                        bool is_obstacle, const InsertionConfig& config,
-                        Eigen::Vector3d& ray_end, bool& obstacle,
+bool Map::acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool is_obstacle,
+                        const InsertionConfig& config, Eigen::Vector3d& ray_end, bool& obstacle,
                         InsertionResult& result) const {
   if (!origin.allFinite() || !end.allFinite()) {
     ++result.rejected_non_finite;
@@ -271,8 +273,8 @@ bool Map::acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& en
     ++result.ignored_out_of_range;
     return false;
   }
-  ray_end = length > config.max_range ? Eigen::Vector3d(origin + ray * (config.max_range / length))
-                                      : end;
+  ray_end =
+      length > config.max_range ? Eigen::Vector3d(origin + ray * (config.max_range / length)) : end;
   if (obstacle) {
     ++result.obstacle_readings;
   } else {
@@ -287,11 +289,10 @@ namespace {
 /// The positive volumes a scan creates, per cell, for the Sec. V.B remedy.
 using ScanPositives = std::unordered_map<std::uint64_t, std::vector<Volume>>;
 
-bool conflictsWithScan(const ScanPositives* positives, const CellIndex& cell,
+bool conflictsWithScan(const ScanPositives& positives, const CellIndex& cell,
                        const Volume& negative) {
-  if (positives == nullptr) return false;
-  const auto it = positives->find(packKey(cell.x, cell.y));
-  if (it == positives->end()) return false;
+  const auto it = positives.find(packKey(cell.x, cell.y));
+  if (it == positives.end()) return false;
   return std::any_of(it->second.begin(), it->second.end(), [&](const Volume& positive) {
     return positive.bottom < negative.top && negative.bottom < positive.top;
   });
@@ -299,20 +300,22 @@ bool conflictsWithScan(const ScanPositives* positives, const CellIndex& cell,
 
 /// Sec. III-B.2: the volumes one reading creates, handed to emit(cell, sign, volume) in the
 /// order the paper creates them. `start` and `end` are in grid units.
-template <class Emit>
+/// Only cells for which owns(cell) holds are emitted (see the threaded Map::insertScan).
+template <class Owns, class Emit>
 void volumesOfReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
                       bool model_negative_space, float unit_mass,
-                      const ScanPositives* scan_positives, Emit&& emit) {
+                      const ScanPositives* scan_positives, Owns&& owns, Emit&& emit) {
   auto emit_negative = [&](const CellIndex& cell, double z_a, double z_b) {
     if (!model_negative_space) return;
     const Volume negative = makeVolume(static_cast<float>(z_a), static_cast<float>(z_b), unit_mass);
-    if (!conflictsWithScan(scan_positives, cell, negative)) {
+    if (scan_positives == nullptr || !conflictsWithScan(*scan_positives, cell, negative)) {
       emit(cell, VolumeSign::kNegative, negative);
     }
   };
   const float end_z = static_cast<float>(end.z());
   walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
           [&](const CellIndex& cell, double z_enter, double z_exit, bool is_last) {
+            if (!owns(cell)) return;
             if (!is_last || !obstacle) {
               emit_negative(cell, z_enter, z_exit);  // eqs. (3) and (4)
               return;
@@ -385,11 +388,12 @@ InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::V
   ++revision_;
   const float unit_mass = static_cast<float>(1.0 / mass_unit_);
   TileWriter writer(*this, nullptr);
-  volumesOfReading(origin * scale_inverse_, ray_end * scale_inverse_, obstacle,
-                   config.model_negative_space, unit_mass, nullptr,
-                   [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
-                     writer.insert(cell, sign, volume, unit_mass);
-                   });
+  volumesOfReading(
+      origin * scale_inverse_, ray_end * scale_inverse_, obstacle, config.model_negative_space,
+      unit_mass, nullptr, [](const CellIndex&) { return true; },
+      [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
+        writer.insert(cell, sign, volume, unit_mass);
+      });
   bytes_in_cells_ += writer.bytesAdded();
   growBounds(writer.touched());
   return result;
@@ -430,80 +434,61 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
           makeVolume(z - 0.5f, z + 0.5f, unit_mass));
     }
   }
-  auto volumes_of = [&](const Reading& reading, auto&& emit) {
+  auto volumes_of = [&](const Reading& reading, auto&& owns, auto&& emit) {
     volumesOfReading(start, reading.end, reading.obstacle, config.model_negative_space, unit_mass,
-                     scan_positives.get(), emit);
+                     scan_positives.get(), owns, emit);
   };
 
   const auto num_threads = static_cast<std::size_t>(config.num_threads);
   if (num_threads == 1) {
     TileWriter writer(*this, nullptr);
     for (const Reading& reading : readings) {
-      volumes_of(reading, [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
-        writer.insert(cell, sign, volume, unit_mass);
-      });
+      volumes_of(
+          reading, [](const CellIndex&) { return true; },
+          [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
+            writer.insert(cell, sign, volume, unit_mass);
+          });
     }
     bytes_in_cells_ += writer.bytesAdded();
     growBounds(writer.touched());
     return result;
   }
 
-  // Several threads, same map: each tile has one owner thread, and every cell receives its
-  // volumes in the same order as in the single-threaded loop above. Phase 1 rasterises slices of
-  // a chunk of readings into per-(slice, owner) buckets; phase 2 lets each owner apply its
-  // buckets slice by slice, i.e. in reading order.
-  struct Contribution {
-    CellIndex cell;
-    Volume volume;
-    VolumeSign sign;
-  };
+  // Several threads, same map: each tile has one owner thread. Every thread walks every reading
+  // in order but inserts only into the tiles it owns, so every cell receives exactly the volumes
+  // of the single-threaded loop above, in the same order. Tiles a thread creates are kept aside
+  // (the tile index is only read while the threads run) and added afterwards.
   auto owner_of = [num_threads](const CellIndex& cell) {
     const TileIndex t = tileOf(cell);
     const auto diagonal = static_cast<std::int64_t>(t.x) + t.y;
     const auto n = static_cast<std::int64_t>(num_threads);
     return static_cast<std::size_t>(((diagonal % n) + n) % n);
   };
-  std::vector<std::vector<std::vector<Contribution>>> buckets(
-      num_threads, std::vector<std::vector<Contribution>>(num_threads));
   std::vector<std::unordered_map<std::uint64_t, std::unique_ptr<Tile>>> created(num_threads);
   std::vector<std::ptrdiff_t> bytes_added(num_threads, 0);
   std::vector<CellRange> touched(num_threads, CellRange{{0, 0}, {-1, -1}});
-  auto run_parallel = [num_threads](auto&& task) {
-    std::vector<std::thread> workers;
-    for (std::size_t t = 1; t < num_threads; ++t) workers.emplace_back(task, t);
-    task(std::size_t{0});
-    for (std::thread& worker : workers) worker.join();
-  };
-  for (std::size_t chunk = 0; chunk < readings.size(); chunk += kReadingsPerChunk) {
-    const std::size_t chunk_end = std::min(readings.size(), chunk + kReadingsPerChunk);
-    run_parallel([&](std::size_t slice) {
-      const std::size_t per_slice = (chunk_end - chunk + num_threads - 1) / num_threads;
-      const std::size_t begin = std::min(chunk_end, chunk + slice * per_slice);
-      const std::size_t end = std::min(chunk_end, begin + per_slice);
-      for (auto& bucket : buckets[slice]) bucket.clear();
-      for (std::size_t r = begin; r < end; ++r) {
-        volumes_of(readings[r], [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
-          buckets[slice][owner_of(cell)].push_back({cell, volume, sign});
-        });
-      }
-    });
-    run_parallel([&](std::size_t owner) {
-      TileWriter writer(*this, &created[owner]);
-      for (std::size_t slice = 0; slice < num_threads; ++slice) {
-        for (const Contribution& c : buckets[slice][owner]) {
-          writer.insert(c.cell, c.sign, c.volume, unit_mass);
-        }
-      }
-      bytes_added[owner] += writer.bytesAdded();
-      include(touched[owner], writer.touched());
-    });
-    for (auto& tiles : created) {
-      for (auto& entry : tiles) tiles_.emplace(entry.first, std::move(entry.second));
-      tiles.clear();
+  auto insert_owned = [&](std::size_t owner) {
+    TileWriter writer(*this, &created[owner]);
+    for (const Reading& reading : readings) {
+      volumes_of(
+          reading, [&](const CellIndex& cell) { return owner_of(cell) == owner; },
+          [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
+            writer.insert(cell, sign, volume, unit_mass);
+          });
     }
+    bytes_added[owner] = writer.bytesAdded();
+    touched[owner] = writer.touched();
+  };
+  std::vector<std::thread> workers;
+  for (std::size_t owner = 1; owner < num_threads; ++owner)
+    workers.emplace_back(insert_owned, owner);
+  insert_owned(0);
+  for (std::thread& worker : workers) worker.join();
+  for (std::size_t owner = 0; owner < num_threads; ++owner) {
+    for (auto& entry : created[owner]) tiles_.emplace(entry.first, std::move(entry.second));
+    bytes_in_cells_ += bytes_added[owner];
+    growBounds(touched[owner]);
   }
-  for (std::ptrdiff_t bytes : bytes_added) bytes_in_cells_ += bytes;
-  for (const CellRange& cells : touched) growBounds(cells);
   return result;
 }
 
@@ -608,9 +593,9 @@ CrossSection Map::crossSection(double z, const CellRange& cells) const {
 namespace {
 
 /// Occupancy of a column over the band [low, high] (grid units), see Map::projection.
-OccupancyState bandState(const Volume* positive, std::uint32_t num_positive,
-                         const Volume* negative, std::uint32_t num_negative, float low,
-                         float high, double occupancy_threshold) {
+OccupancyState bandState(const Volume* positive, std::uint32_t num_positive, const Volume* negative,
+                         std::uint32_t num_negative, float low, float high,
+                         double occupancy_threshold) {
   auto in_band = [&](const Volume& v) { return v.top >= low && v.bottom <= high && v.mass > 0; };
   bool known = std::any_of(negative, negative + num_negative, in_band);
   for (const Volume* p = positive; p != positive + num_positive; ++p) {
@@ -645,8 +630,8 @@ Projection Map::projection(double z_min, double z_max, double occupancy_threshol
   const auto high = static_cast<float>(z_max * scale_inverse_);
   return fillGrid<OccupancyState>(cells, OccupancyState::kUnknown, [&](const Cell& cell) {
     return bandState(cell.list(VolumeSign::kPositive), cell.count(VolumeSign::kPositive),
-                     cell.list(VolumeSign::kNegative), cell.count(VolumeSign::kNegative), low,
-                     high, occupancy_threshold);
+                     cell.list(VolumeSign::kNegative), cell.count(VolumeSign::kNegative), low, high,
+                     occupancy_threshold);
   });
 }
 
@@ -734,7 +719,8 @@ MemoryUsage Map::memoryUsage() const {
   const std::size_t tile_index_bytes =
       tiles_.bucket_count() * sizeof(void*) +
       tiles_.size() * (sizeof(void*) + sizeof(decltype(tiles_)::value_type));
-  usage.bytes_held = sizeof(Map) + tile_index_bytes + tiles_.size() * sizeof(Tile) + bytes_in_cells_;
+  usage.bytes_held =
+      sizeof(Map) + tile_index_bytes + tiles_.size() * sizeof(Tile) + bytes_in_cells_;
   usage.minimal_grid_cells = static_cast<std::size_t>(bounds_.width() * bounds_.height());
   usage.table_one_bytes = usage.minimal_grid_cells * 8 +
                           (usage.positive_volumes + usage.negative_volumes) * sizeof(Volume);

@@ -6,31 +6,17 @@
 
 namespace mvog {
 
-Volume makeVolume(float z_a, float z_b, float unit_mass) {
-  Volume volume{std::min(z_a, z_b), std::max(z_a, z_b), 0.0f};
-  if (volume.height() < kMinVolumeHeight) {
-    const float centre = 0.5f * (volume.bottom + volume.top);  // eq. (6)
-    volume.bottom = centre - 0.5f * kMinVolumeHeight;
-    volume.top = centre + 0.5f * kMinVolumeHeight;
-    // The float sum may round to just under the minimum height; nudge the top up to it.
-    while (volume.height() < kMinVolumeHeight) volume.top = std::nextafter(volume.top, INFINITY);
-  }
-  volume.mass = volume.height() * unit_mass;
-  return volume;
-}
-
 std::uint32_t insertVolume(Volume* list, std::uint32_t count, const Volume& volume,
                            float unit_mass) {
   // Volumes to merge are those whose gap to `volume` is at most kMaxMergeGap (a gap <= 0 is an
   // overlap, eq. 7; a gap in (0, 1] is "too close", eq. 8). The list is sorted and its own gaps
   // exceed 1, so they form one run [first, last) and the merged volume is within 1 of no other.
   Volume* const end = list + count;
-  Volume* first = std::partition_point(list, end, [&](const Volume& v) {
-    return volume.bottom - v.top > kMaxMergeGap;
-  });
-  Volume* last = std::partition_point(first, end, [&](const Volume& v) {
-    return v.bottom - volume.top <= kMaxMergeGap;
-  });
+  // Columns hold a handful of volumes: a linear scan beats a binary search there.
+  Volume* first = list;
+  while (first != end && volume.bottom - first->top > kMaxMergeGap) ++first;
+  Volume* last = first;
+  while (last != end && last->bottom - volume.top <= kMaxMergeGap) ++last;
   if (first == last) {
     std::memmove(first + 1, first, static_cast<std::size_t>(end - first) * sizeof(Volume));
     *first = volume;
@@ -48,7 +34,9 @@ std::uint32_t insertVolume(Volume* list, std::uint32_t count, const Volume& volu
   // Every gap that the merge fills is added at density 1 (eq. 8b).
   merged.mass += std::max(0.0f, merged.height() - covered) * unit_mass;
   *first = merged;
-  std::memmove(first + 1, last, static_cast<std::size_t>(end - last) * sizeof(Volume));
+  if (last != first + 1) {
+    std::memmove(first + 1, last, static_cast<std::size_t>(end - last) * sizeof(Volume));
+  }
   return count - static_cast<std::uint32_t>(last - first) + 1;
 }
 
