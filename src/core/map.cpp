@@ -350,8 +350,10 @@ class Map::TileWriter {
     return last_tile_->at(index);
   }
   void insert(const CellIndex& index, VolumeSign sign, const Volume& volume, float unit_mass) {
-    bytes_added_ += cell(index).insert(sign, volume, unit_mass, map_.unit_exponent_);
-    include(touched_, {index, index});
+    Cell& target = cell(index);
+    // Only a cell receiving its first volume can lie outside the bounds of the cells with volumes.
+    if (target.empty()) include(touched_, {index, index});
+    bytes_added_ += target.insert(sign, volume, unit_mass, map_.unit_exponent_);
   }
   std::ptrdiff_t bytesAdded() const { return bytes_added_; }
   const CellRange& touched() const { return touched_; }
@@ -375,7 +377,9 @@ class Map::TileWriter {
   std::uint64_t last_key_ = 0;
   Tile* last_tile_ = nullptr;
   std::ptrdiff_t bytes_added_ = 0;
-  CellRange touched_{{0, 0}, {-1, -1}};
+  CellRange touched_{
+      {std::numeric_limits<std::int32_t>::max(), std::numeric_limits<std::int32_t>::max()},
+      {std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()}};
 };
 
 InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
