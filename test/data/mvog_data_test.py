@@ -24,11 +24,11 @@ import rosbag
 import rospy
 import rostest
 import tf2_ros
+from geometry_msgs.msg import Point
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan, PointCloud2
 from tf2_msgs.msg import TFMessage
 
-from geometry_msgs.msg import Point
 from mvog.msg import MapStatistics
 from mvog.srv import GetOccupancy, GetOccupancyRequest
 
@@ -303,7 +303,8 @@ class DataTestCase(unittest.TestCase):
 class CloudReplayTest(DataTestCase):
     """A bag of PointCloud2 messages (depth camera, 3D laser) replayed into the server.
 
-    Subclasses set BAG, TOPIC, RATE, README_MESSAGES, README_POINTS, README_FLOOR (the floor's
+    Subclasses set BAG, TOPIC, RATE, README_MESSAGES, README_POINTS, README_FRAME (the clouds'
+    frame_id), README_FLOOR (the floor's
     height in the map frame, from the data README), NEAR_RANGE (returns closer than this are
     left out of the occupancy checks: robot self-hits) and the fractions the checks demand
     (explained there).
@@ -311,6 +312,7 @@ class CloudReplayTest(DataTestCase):
     BAG = TOPIC = None
     RATE = 1.0
     README_MESSAGES = README_POINTS = 0
+    README_FRAME = None
     README_FLOOR = 0.0
     NEAR_RANGE = 0.0
     RETURNS_OCCUPIED = RETURNS_NEAR_OCCUPIED = FLOOR_OCCUPIED = FLOOR_NEAR_OCCUPIED = 1.0
@@ -382,6 +384,7 @@ class CloudReplayTest(DataTestCase):
     def test_bag_matches_readme(self):
         self.assertEqual(len(self.poses), self.README_MESSAGES)
         self.assertEqual(sum(len(p) for p in self.points), self.README_POINTS)
+        self.assertEqual(self.frames, {self.README_FRAME})
         self.assertAlmostEqual(self.floor, self.README_FLOOR, delta=0.05)
 
     def test_statistics_count_every_message_and_reading(self):

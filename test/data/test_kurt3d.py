@@ -16,6 +16,7 @@ class Kurt3d(data.CloudReplayTest):
     BAG = "kurt3d_3scans.bag"
     TOPIC = "/kurt3d/points"
     # The data README's facts: 3 clouds, 233,028 points, the floor's 5th percentile -0.56 m.
+    README_FRAME = "kurt3d_scanner"
     README_MESSAGES, README_POINTS, README_FLOOR = 3, 233028, -0.56
     RATE = 4.0  # 20 s of bag in 5 s; the three clouds take ~0.2 s each to insert
     NEAR_RANGE = 1.0  # README: about 6,000 returns within 1 m in scans 0 and 2, maybe the robot

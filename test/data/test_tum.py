@@ -18,6 +18,7 @@ class Tum(data.CloudReplayTest):
     BAG = "tum_fr2_pioneer_10frames.bag"
     TOPIC = "/camera/depth/points"
     # The data README's facts: 10 clouds, 2,573,870 points, the floor's 5th percentile -0.03 m.
+    README_FRAME = "openni_depth_optical_frame"
     README_MESSAGES, README_POINTS, README_FLOOR = 10, 2573870, -0.03
     # The mapper needs ~2 s per cloud at 5 cm; the queue (tum.test) holds the clouds meanwhile.
     RATE = 2.0
