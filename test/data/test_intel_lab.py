@@ -6,7 +6,6 @@ slab at the laser's height. Checked: dense clusters of endpoints (walls) are occ
 path is free, everything no ray came near (outside the building, far away) and every height off
 the scan plane is unknown, and the statistics count every message and reading of the bag.
 """
-import unittest
 
 import numpy as np
 import rosbag

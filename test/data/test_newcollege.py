@@ -7,7 +7,6 @@ wall with vegetation ~4 m away and up to ~5 m high, on the right open ground out
 vertical, the space beside each scanner and the open sky on the right are free, below the ground,
 behind the wall and far away is unknown, and the statistics count every scan and reading.
 """
-import unittest
 
 import numpy as np
 import rosbag
