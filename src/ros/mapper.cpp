@@ -15,7 +15,8 @@
 namespace mvog_ros {
 namespace {
 
-constexpr double kWarningPeriod = 5.0;  // s between two warnings of one kind
+constexpr double kWarningPeriod = 5.0;          // s between two warnings of one kind
+constexpr double kTransformRetryPeriod = 0.01;  // s between checks for awaited transforms
 
 /// Creates ~map_directory if missing and returns the map a server starts with: ~map_file if set,
 /// else an empty one. Throws mvog::ConfigError naming the parameter at fault.
@@ -118,17 +119,21 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
   insertion_thread_ = std::thread(&Mapper::insertionLoop, this);
 
   // Inputs last, once everything they feed exists.
-  subscribe("scan", scan_inputs_);
-  for (const std::string& topic : config_.scan_topics) subscribe(topic, scan_inputs_);
-  subscribe("cloud_in", cloud_inputs_);
-  for (const std::string& topic : config_.cloud_topics) subscribe(topic, cloud_inputs_);
+  subscribe<sensor_msgs::LaserScan>("scan");
+  for (const std::string& topic : config_.scan_topics) subscribe<sensor_msgs::LaserScan>(topic);
+  subscribe<sensor_msgs::PointCloud2>("cloud_in");
+  for (const std::string& topic : config_.cloud_topics) {
+    subscribe<sensor_msgs::PointCloud2>(topic);
+  }
+  timers_.push_back(
+      nh_.createTimer(ros::Duration(kTransformRetryPeriod), &Mapper::retryWaitingMessages, this));
   ROS_INFO("mvog: mapping in '%s' at %.3f m, %zu scan and %zu cloud topics",
-           config_.frame_id.c_str(), map_.resolution(), scan_inputs_.size(), cloud_inputs_.size());
+           config_.frame_id.c_str(), map_.resolution(), config_.scan_topics.size() + 1,
+           config_.cloud_topics.size() + 1);
 }
 
 Mapper::~Mapper() {
-  for (auto& input : scan_inputs_) input.subscriber->unsubscribe();
-  for (auto& input : cloud_inputs_) input.subscriber->unsubscribe();
+  for (const std::unique_ptr<SensorInput>& input : inputs_) input->subscriber.shutdown();
   for (ros::Timer& timer : timers_) timer.stop();
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);
@@ -139,43 +144,69 @@ Mapper::~Mapper() {
 }
 
 template <class Message>
-void Mapper::subscribe(const std::string& topic, std::vector<SensorInput<Message>>& inputs) {
-  SensorInput<Message> input;
-  input.subscriber = std::make_unique<message_filters::Subscriber<Message>>(
-      nh_, topic, static_cast<std::uint32_t>(config_.sensor_queue_size));
-  input.filter = std::make_unique<tf2_ros::MessageFilter<Message>>(
-      *input.subscriber, tf_buffer_, config_.frame_id,
-      static_cast<std::uint32_t>(config_.sensor_queue_size), nh_);
-  input.filter->registerFailureCallback(
-      [this](const boost::shared_ptr<const Message>& message,
-             tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-        ++counters_.messages_dropped_tf;
-        ROS_WARN_THROTTLE(kWarningPeriod,
-                          "mvog: dropped a message from frame '%s' at %.3f: %s (%llu so far)",
-                          message->header.frame_id.c_str(), message->header.stamp.toSec(),
-                          reason == tf2_ros::filter_failure_reasons::EmptyFrameID
-                              ? "its frame_id is empty"
-                              : "no transform to the map frame in time",
-                          static_cast<unsigned long long>(counters_.messages_dropped_tf.load()));
+void Mapper::subscribe(const std::string& topic) {
+  inputs_.push_back(std::make_unique<SensorInput>());
+  SensorInput* input = inputs_.back().get();
+  input->subscriber = nh_.subscribe<Message>(
+      topic, static_cast<std::uint32_t>(config_.sensor_queue_size),
+      [this, input](const boost::shared_ptr<const Message>& message) {
+        receive(*input, {message->header, [this, message](const Eigen::Isometry3d& pose) {
+                           if constexpr (std::is_same_v<Message, sensor_msgs::LaserScan>) {
+                             insertScan(*message, pose);
+                           } else {
+                             insertCloud(*message, pose);
+                           }
+                         }});
       });
-  if constexpr (std::is_same_v<Message, sensor_msgs::LaserScan>) {
-    input.filter->registerCallback(&Mapper::onScan, this);
-  } else {
-    input.filter->registerCallback(&Mapper::onCloud, this);
-  }
-  inputs.push_back(std::move(input));
 }
 
-bool Mapper::sensorPose(const std_msgs::Header& header, Eigen::Isometry3d& map_from_sensor) {
-  try {
-    map_from_sensor = tf2::transformToEigen(
-        tf_buffer_.lookupTransform(config_.frame_id, header.frame_id, header.stamp));
-    return true;
-  } catch (const tf2::TransformException& e) {
-    ++counters_.messages_dropped_tf;
-    ROS_WARN_THROTTLE(kWarningPeriod, "mvog: dropped a message: %s", e.what());
-    return false;
+void Mapper::receive(SensorInput& input, SensorMessage&& message) {
+  std::string& frame_id = message.header.frame_id;
+  if (!frame_id.empty() && frame_id.front() == '/') frame_id.erase(0, 1);  // tf1 style
+  if (frame_id.empty()) {
+    dropForTransform(message.header, "its frame_id is empty");
+    return;
   }
+  std::lock_guard<std::mutex> lock(input.mutex);
+  input.waiting.push_back(std::move(message));
+  insertTransformable(input);
+  if (input.waiting.size() > static_cast<std::size_t>(config_.sensor_queue_size)) {
+    dropForTransform(input.waiting.front().header,
+                     "no transform to the map frame before ~sensor_queue_size newer messages");
+    input.waiting.pop_front();
+  }
+}
+
+void Mapper::insertTransformable(SensorInput& input) {
+  for (auto message = input.waiting.begin(); message != input.waiting.end();) {
+    if (!tf_buffer_.canTransform(config_.frame_id, message->header.frame_id,
+                                 message->header.stamp)) {
+      ++message;
+      continue;
+    }
+    try {
+      message->insert(tf2::transformToEigen(tf_buffer_.lookupTransform(
+          config_.frame_id, message->header.frame_id, message->header.stamp)));
+    } catch (const tf2::TransformException& e) {  // gone from the cache since canTransform
+      dropForTransform(message->header, e.what());
+    }
+    message = input.waiting.erase(message);
+  }
+}
+
+void Mapper::retryWaitingMessages(const ros::TimerEvent&) {
+  for (const std::unique_ptr<SensorInput>& input : inputs_) {
+    std::lock_guard<std::mutex> lock(input->mutex);
+    insertTransformable(*input);
+  }
+}
+
+void Mapper::dropForTransform(const std_msgs::Header& header, const std::string& why) {
+  ++counters_.messages_dropped_tf;
+  ROS_WARN_THROTTLE(kWarningPeriod,
+                    "mvog: dropped a message from frame '%s' at %.3f: %s (%llu so far)",
+                    header.frame_id.c_str(), header.stamp.toSec(), why.c_str(),
+                    static_cast<unsigned long long>(counters_.messages_dropped_tf.load()));
 }
 
 void Mapper::rejectMessage(const std::string& topic_kind, const std::string& why) {
@@ -185,12 +216,11 @@ void Mapper::rejectMessage(const std::string& topic_kind, const std::string& why
                     static_cast<unsigned long long>(counters_.messages_dropped_invalid.load()));
 }
 
-void Mapper::onScan(const sensor_msgs::LaserScanConstPtr& scan) {
-  Eigen::Isometry3d map_from_sensor;
-  if (!sensorPose(scan->header, map_from_sensor)) return;
+void Mapper::insertScan(const sensor_msgs::LaserScan& scan,
+                        const Eigen::Isometry3d& map_from_sensor) {
   try {
     std::size_t skipped = 0;
-    PendingScan pending{scanToReadings(*scan, map_from_sensor, config_.insertion.max_range,
+    PendingScan pending{scanToReadings(scan, map_from_sensor, config_.insertion.max_range,
                                        static_cast<std::size_t>(config_.max_points_per_message),
                                        skipped),
                         "LaserScan"};
@@ -201,12 +231,11 @@ void Mapper::onScan(const sensor_msgs::LaserScanConstPtr& scan) {
   }
 }
 
-void Mapper::onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud) {
-  Eigen::Isometry3d map_from_sensor;
-  if (!sensorPose(cloud->header, map_from_sensor)) return;
+void Mapper::insertCloud(const sensor_msgs::PointCloud2& cloud,
+                         const Eigen::Isometry3d& map_from_sensor) {
   try {
     PendingScan pending{
-        cloudToReadings(*cloud, map_from_sensor,
+        cloudToReadings(cloud, map_from_sensor,
                         static_cast<std::size_t>(config_.max_points_per_message)),
         "PointCloud2"};
     if (config_.voxel_filter_size > 0.0) {

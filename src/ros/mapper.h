@@ -3,6 +3,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <shared_mutex>
@@ -11,13 +12,11 @@
 #include <vector>
 
 #include <Eigen/Geometry>
-#include <message_filters/subscriber.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_listener.h>
 
 #include "mapper_config.h"
@@ -32,7 +31,10 @@ namespace mvog_ros {
 /// The mapping server: subscribes to range sensors, feeds the MVOG core, publishes the map and
 /// answers queries. Shared by the nodelet and the node. Callbacks may run on several threads:
 /// the map is guarded by a readers-writer lock, and insertion runs on its own thread behind a
-/// bounded queue that drops the oldest message when the sensors outpace it.
+/// bounded queue that drops the oldest message when the sensors outpace it. A sensor message
+/// whose transform to the map frame has not arrived yet waits for it (up to ~sensor_queue_size
+/// messages per topic); tf2_ros::MessageFilter is not used: its version here loses a message
+/// for good when the transform arrives while the message is being registered.
 class Mapper {
  public:
   /// Throws mvog::ConfigError naming the parameter at fault (~map_file if it cannot be loaded).
@@ -42,10 +44,16 @@ class Mapper {
   Mapper& operator=(const Mapper&) = delete;
 
  private:
-  template <class Message>
+  /// A sensor message: its header, and what inserts it given the sensor's pose.
+  struct SensorMessage {
+    std_msgs::Header header;
+    std::function<void(const Eigen::Isometry3d& map_from_sensor)> insert;
+  };
+  /// One sensor topic and its messages waiting for their transform, oldest first.
   struct SensorInput {
-    std::unique_ptr<message_filters::Subscriber<Message>> subscriber;
-    std::unique_ptr<tf2_ros::MessageFilter<Message>> filter;
+    std::mutex mutex;
+    std::deque<SensorMessage> waiting;
+    ros::Subscriber subscriber;
   };
   struct PendingScan {
     mvog::Scan scan;
@@ -63,10 +71,17 @@ class Mapper {
   };
 
   template <class Message>
-  void subscribe(const std::string& topic, std::vector<SensorInput<Message>>& inputs);
-  void onScan(const sensor_msgs::LaserScanConstPtr& scan);
-  void onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud);
-  bool sensorPose(const std_msgs::Header& header, Eigen::Isometry3d& map_from_sensor);
+  void subscribe(const std::string& topic);
+  /// Inserts the message if its transform is there, else keeps it waiting.
+  void receive(SensorInput& input, SensorMessage&& message);
+  /// Inserts the waiting messages of `input` whose transforms have arrived (under its mutex).
+  void insertTransformable(SensorInput& input);
+  /// Retries every waiting message (timer): transforms arrive on tf's own thread.
+  void retryWaitingMessages(const ros::TimerEvent&);
+  void dropForTransform(const std_msgs::Header& header, const std::string& why);
+  void insertScan(const sensor_msgs::LaserScan& scan, const Eigen::Isometry3d& map_from_sensor);
+  void insertCloud(const sensor_msgs::PointCloud2& cloud,
+                   const Eigen::Isometry3d& map_from_sensor);
   void rejectMessage(const std::string& topic_kind, const std::string& why);
   void enqueue(PendingScan&& pending);
   void insertionLoop();
@@ -101,8 +116,8 @@ class Mapper {
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
-  std::vector<SensorInput<sensor_msgs::LaserScan>> scan_inputs_;
-  std::vector<SensorInput<sensor_msgs::PointCloud2>> cloud_inputs_;
+  /// Filled in the constructor only; callbacks hold pointers to the inputs.
+  std::vector<std::unique_ptr<SensorInput>> inputs_;
 
   std::mutex queue_mutex_;
   std::condition_variable queue_changed_;
