@@ -367,7 +367,11 @@ class MapperClient {
   void waitForInsertedMessages(std::uint64_t count) {
     const mvog::MapStatistics statistics = waitForStatistics(
         [count](const mvog::MapStatistics& s) { return s.messages_inserted >= count; });
-    ASSERT_EQ(statistics.messages_inserted, count) << name_;
+    ASSERT_EQ(statistics.messages_inserted, count)
+        << name_ << ": dropped " << statistics.messages_dropped_tf << " for tf, "
+        << statistics.messages_dropped_queue << " from the queue, "
+        << statistics.messages_dropped_invalid << " invalid; " << statistics.readings_inserted
+        << " readings inserted";
   }
 
  private:
