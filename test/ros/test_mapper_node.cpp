@@ -419,18 +419,25 @@ class SceneSensors {
     });
   }
 
-  /// One scan of the moving laser with its base at y, with three beams that say nothing.
+  /// One scan of the moving laser with its base at y, and the base's pose before it.
   void publishMovingScan(const std::string& topic, double base_y) {
     const ros::Time stamp = ros::Time::now();
+    publishBasePose(base_y, stamp);
+    publisher<sensor_msgs::LaserScan>(topic).publish(movingScan(base_y, stamp));
+  }
+  void publishBasePose(double base_y, const ros::Time& stamp) {
     tf2_msgs::TFMessage tf;
     tf.transforms.push_back(transform(mapFromBase(base_y), "map", "base_link", stamp));
     tf_.publish(tf);
+  }
+  /// A scan of the moving laser with its base at y, with three beams that say nothing.
+  static sensor_msgs::LaserScan movingScan(double base_y, const ros::Time& stamp) {
     sensor_msgs::LaserScan scan =
         scanOf(mapFromBase(base_y) * kBaseFromLaser, kMovingLaser, {kWall}, "laser", stamp);
     scan.ranges[0] = std::numeric_limits<float>::quiet_NaN();
     scan.ranges[1] = -std::numeric_limits<float>::infinity();
     scan.ranges[2] = kLaserRangeMin / 2.0f;
-    publisher<sensor_msgs::LaserScan>(topic).publish(scan);
+    return scan;
   }
   void publishDecayScan(const std::vector<std::string>& topics, bool with_person) {
     std::vector<Box> boxes{kWall};
@@ -632,6 +639,28 @@ TEST_F(Mapper, AnswersUnknownAtNaNAndRefusesWhatItCannotAnswer) {
   EXPECT_FALSE(response.success);
   EXPECT_TRUE(response.state.empty());
   EXPECT_NE(response.message.find("'no_such_frame'"), std::string::npos) << response.message;
+}
+
+TEST_F(Mapper, WaitsForTransformsThatComeLate) {
+  // The base's pose comes after the scan (the pause only makes that order likely).
+  const ros::Time stamp = ros::Time::now();
+  sensors_->publisher<sensor_msgs::LaserScan>("/scan").publish(
+      SceneSensors::movingScan(0.0, stamp));
+  ros::WallDuration(0.2).sleep();
+  sensors_->publishBasePose(0.0, stamp);
+  server_->waitForInsertedMessages(1);
+  // A tf1-style frame id with a leading slash is fine; a message without frame id is dropped.
+  sensor_msgs::LaserScan scan =
+      scanOf(kMapFromDecayLaser, kDecayLaser, {kWall}, "/decay_laser", ros::Time::now());
+  sensors_->publisher<sensor_msgs::LaserScan>("/scan").publish(scan);
+  scan.header.frame_id.clear();
+  sensors_->publisher<sensor_msgs::LaserScan>("/scan").publish(scan);
+  const mvog::MapStatistics statistics = server_->waitForStatistics(
+      [](const mvog::MapStatistics& s) { return s.messages_dropped_tf >= 1; });
+  EXPECT_EQ(statistics.messages_dropped_tf, 1u);
+  server_->waitForInsertedMessages(2);
+  EXPECT_EQ(server_->state({3.05, 0.05, kLaserHeight}), kOccupied);
+  EXPECT_EQ(server_->state({1.55, 0.05, kLaserHeight}), kFree);
 }
 
 /// The value of a grid at a world point, or -2 if the point is outside it.
