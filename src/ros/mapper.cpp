@@ -436,10 +436,9 @@ void Mapper::decay(const ros::TimerEvent&) {
 
 void Mapper::autosave(const ros::TimerEvent&) {
   try {
-    const std::string path = resolveMapPath(config_.map_directory, config_.autosave_file, true);
     std::shared_lock<std::shared_mutex> lock(map_mutex_);
     if (map_.revision() == saved_revision_) return;
-    mvog::saveMap(map_, path);
+    mvog::saveMap(map_, resolveMapPath(config_.map_directory, config_.autosave_file, true));
     saved_revision_ = map_.revision();
   } catch (const std::exception& e) {
     ROS_WARN_THROTTLE(kWarningPeriod, "mvog: autosave failed: %s", e.what());
