@@ -102,6 +102,8 @@ mvog::Scan cloudToReadings(const sensor_msgs::PointCloud2& cloud,
   const bool swap_bytes = static_cast<bool>(cloud.is_bigendian) != kHostIsBigEndian;
   mvog::Scan readings;
   readings.origin = map_from_sensor.translation();
+  // Nothing to read (width or height 0): row pointers into the data would point nowhere.
+  if (num_points == 0) return readings;
   readings.hits.reserve(num_points);
   for (std::uint32_t row = 0; row < cloud.height; ++row) {
     const std::uint8_t* point = cloud.data.data() + std::size_t{row} * cloud.row_step;
