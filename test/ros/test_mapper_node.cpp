@@ -241,6 +241,12 @@ std::vector<geometry_msgs::Point> toPoints(const std::vector<Probe>& probes,
 
 // ---- A mapping server seen from outside -------------------------------------------------------
 
+/// The bytes of a file, or nothing if it cannot be read.
+std::string readFile(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+}
+
 /// Removes a server's ~map_directory if the tests left it empty (rmdir refuses anything else).
 void removeEmptyMapDirectory(const std::string& server) {
   std::string directory;
@@ -492,9 +498,12 @@ class Mapper : public ::testing::Test {
     server_ = std::make_unique<MapperClient>(name);
   }
   static void TearDownTestSuite() {
-    // The final map is autosaved once, then never again: the directory can be emptied.
+    // Empty the map directory for good: once an empty map is autosaved after the reset, nothing
+    // changes, so nothing is saved anymore.
+    std::remove(autosavePath().c_str());
+    server_->reset();
     EXPECT_TRUE(waitForAutosave());
-    std::remove((mapDirectory() + "/autosave.mvog").c_str());
+    std::remove(autosavePath().c_str());
     removeEmptyMapDirectory(server_->name());
     server_.reset();
     sensors_.reset();
@@ -532,18 +541,17 @@ class Mapper : public ::testing::Test {
     return directory;
   }
 
-  /// Waits until ~autosave_file (autosave.mvog in mapper_test.yaml) holds the current map.
+  /// ~autosave_file, autosave.mvog in mapper_test.yaml.
+  static std::string autosavePath() { return mapDirectory() + "/autosave.mvog"; }
+
+  /// Waits until the autosaved file holds the current map: the same bytes as a save of it now.
+  /// The map must not change meanwhile.
   static bool waitForAutosave() {
-    const mvog::GetOccupancy::Response current =
-        server_->query(toPoints(kSceneProbes, Eigen::Isometry3d::Identity()));
-    const std::string path = mapDirectory() + "/autosave.mvog";
-    return waitFor([&] {
-      try {
-        return static_cast<bool>(answersLikeTheServer(mvog::loadMap(path), current));
-      } catch (const mvog::MapFileError&) {
-        return false;  // not saved yet
-      }
-    });
+    const std::string reference_path = mapDirectory() + "/autosave_reference.mvog";
+    if (!server_->save(reference_path).success) return false;
+    const std::string reference = readFile(reference_path);
+    std::remove(reference_path.c_str());
+    return waitFor([&] { return readFile(autosavePath()) == reference; });
   }
 
   static std::unique_ptr<SceneSensors> sensors_;
@@ -841,22 +849,17 @@ TEST_F(Mapper, SavesResetsAndLoads) {
   EXPECT_FALSE(server_->load("missing.mvog").success);
 
   // A corrupted, a truncated and a foreign file are refused, and the map stays as it was.
-  std::vector<char> bytes;
-  {
-    std::ifstream file(directory + "/rostest_map.mvog", std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
-  }
+  const std::string bytes = readFile(directory + "/rostest_map.mvog");
   ASSERT_GT(bytes.size(), 100u);
-  std::vector<char> corrupted = bytes;
+  std::string corrupted = bytes;
   corrupted[bytes.size() / 2] = static_cast<char>(corrupted[bytes.size() / 2] ^ 0x10);
-  const std::vector<std::pair<std::string, std::vector<char>>> bad_files = {
+  const std::vector<std::pair<std::string, std::string>> bad_files = {
       {"corrupted.mvog", corrupted},
-      {"truncated.mvog", std::vector<char>(bytes.begin(), bytes.begin() + bytes.size() / 2)},
-      {"foreign.mvog", std::vector<char>(1000, 'x')},
-      {"empty.mvog", {}}};
+      {"truncated.mvog", bytes.substr(0, bytes.size() / 2)},
+      {"foreign.mvog", std::string(1000, 'x')},
+      {"empty.mvog", ""}};
   for (const auto& bad : bad_files) {
-    std::ofstream(directory + "/" + bad.first, std::ios::binary)
-        .write(bad.second.data(), static_cast<std::streamsize>(bad.second.size()));
+    std::ofstream(directory + "/" + bad.first, std::ios::binary) << bad.second;
     response = server_->load(bad.first);
     EXPECT_FALSE(response.success) << bad.first;
     EXPECT_FALSE(response.message.empty()) << bad.first;
@@ -867,6 +870,7 @@ TEST_F(Mapper, SavesResetsAndLoads) {
 }
 
 TEST_F(Mapper, AutosavesTheMap) {
+  std::remove(autosavePath().c_str());  // whatever the previous tests left: the same scene
   mapScene();
   EXPECT_TRUE(waitForAutosave());
 }
