@@ -294,7 +294,11 @@ TEST(CloudToReadings, AppliesTheSensorPoseAndStartsRaysAtTheSensor) {
 }
 
 TEST(CloudToReadings, AcceptsAnEmptyCloud) {
-  sensor_msgs::PointCloud2 cloud = makeCloud({}, kXyzFloat32, 12, 1);
+  sensor_msgs::PointCloud2 cloud = makeCloud({}, kXyzFloat32, 12, 1);  // height 0
+  EXPECT_TRUE(cloudToReadings(cloud, Eigen::Isometry3d::Identity(), 10).hits.empty());
+  cloud.width = 0;
+  cloud.height = 5;  // rows without points, and no data
+  cloud.row_step = 0;
   EXPECT_TRUE(cloudToReadings(cloud, Eigen::Isometry3d::Identity(), 10).hits.empty());
 }
 
