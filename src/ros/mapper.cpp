@@ -65,19 +65,24 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
   volumes_publisher_ = marker_publisher("volumes", false);
   occupied_publisher_ = marker_publisher("occupied", true);
 
-  grids_.emplace_back(config_.projection_min_z, [this](const mvog::Map& map,
-                                                       const mvog::CellRange& cells) {
-    return toOccupancyGrid(map.projection(config_.projection_min_z, config_.projection_max_z,
-                                          config_.occupancy_threshold, cells),
-                           0.0, "", ros::Time())
-        .data;
-  });
+  const std::int64_t max_grid_cells = config_.max_cross_section_cells;
+  grids_.emplace_back(config_.projection_min_z, max_grid_cells,
+                      [this](const mvog::Map& map, const mvog::CellRange& cells) {
+                        return toOccupancyGrid(map.projection(config_.projection_min_z,
+                                                              config_.projection_max_z,
+                                                              config_.occupancy_threshold, cells),
+                                               0.0, "", ros::Time())
+                            .data;
+                      });
   std::vector<std::string> grid_topics{"projected_map"};
   for (std::size_t k = 0; k < config_.cross_section_heights.size(); ++k) {
     const double height = config_.cross_section_heights[k];
-    grids_.emplace_back(height, [height](const mvog::Map& map, const mvog::CellRange& cells) {
-      return toOccupancyGrid(map.crossSection(height, cells), height, "", ros::Time()).data;
-    });
+    grids_.emplace_back(height, max_grid_cells,
+                        [height](const mvog::Map& map, const mvog::CellRange& cells) {
+                          return toOccupancyGrid(map.crossSection(height, cells), height, "",
+                                                 ros::Time())
+                              .data;
+                        });
     grid_topics.push_back("cross_section_" + std::to_string(k));
     ROS_INFO("mvog: ~%s is the cross-section at z = %.3f m", grid_topics.back().c_str(), height);
   }
@@ -321,15 +326,15 @@ void Mapper::publishChanges(const ros::TimerEvent&) {
   }
   for (std::size_t k = 0; k < grids_.size(); ++k) {
     bool relaid_out = false;
-    const mvog::CellRange touched = grids_[k].update(map_, changed, relaid_out);
-    if (touched.empty()) continue;
+    const std::optional<mvog::CellRange> touched = updateGrid(k, changed, relaid_out);
+    if (!touched || touched->empty()) continue;
     nav_msgs::OccupancyGrid grid = grids_[k].grid();
     grid.header.frame_id = config_.frame_id;
     grid.header.stamp = stamp;
     grid.info.map_load_time = stamp;
     if (grid_publishers_[k].getNumSubscribers() > 0) grid_publishers_[k].publish(grid);
     if (!relaid_out && grid_update_publishers_[k].getNumSubscribers() > 0) {
-      map_msgs::OccupancyGridUpdate update = grids_[k].updateOf(touched);
+      map_msgs::OccupancyGridUpdate update = grids_[k].updateOf(*touched);
       update.header = grid.header;
       grid_update_publishers_[k].publish(update);
     }
@@ -357,12 +362,29 @@ void Mapper::sendGrid(const ros::SingleSubscriberPublisher& subscriber, std::siz
   std::lock_guard<std::mutex> publish_lock(publish_mutex_);
   std::shared_lock<std::shared_mutex> lock(map_mutex_);
   bool relaid_out = false;
-  grids_[layer].update(map_, map_.tilesModifiedSince(published_revision_), relaid_out);
-  if (grids_[layer].cells().empty()) return;  // nothing mapped yet
+  if (!updateGrid(layer, map_.tilesModifiedSince(published_revision_), relaid_out) ||
+      grids_[layer].cells().empty()) {  // too large, or nothing mapped yet
+    return;
+  }
   nav_msgs::OccupancyGrid grid = grids_[layer].grid();
   grid.header.frame_id = config_.frame_id;
   grid.header.stamp = ros::Time::now();
   subscriber.publish(grid);
+}
+
+std::optional<mvog::CellRange> Mapper::updateGrid(std::size_t layer,
+                                                  const std::vector<mvog::TileIndex>& changed,
+                                                  bool& relaid_out) {
+  try {
+    return grids_[layer].update(map_, changed, relaid_out);
+  } catch (const GridTooLarge& e) {
+    ROS_WARN_THROTTLE(kWarningPeriod,
+                      "mvog: %s not published: %s, more than ~max_cross_section_cells (%d); "
+                      "readings far away? (~max_coordinate, ~max_range)",
+                      grid_publishers_[layer].getTopic().c_str(), e.what(),
+                      config_.max_cross_section_cells);
+    return std::nullopt;
+  }
 }
 
 void Mapper::sendBinaryMap(const ros::SingleSubscriberPublisher& subscriber) {

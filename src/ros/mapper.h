@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
 #include <string>
 #include <thread>
@@ -93,6 +94,11 @@ class Mapper {
   void autosave(const ros::TimerEvent&);
   void sendAllMarkers(const ros::SingleSubscriberPublisher& subscriber, bool occupied_only);
   void sendGrid(const ros::SingleSubscriberPublisher& subscriber, std::size_t layer);
+  /// Brings grid `layer` up to date (IncrementalGrid::update): the rectangle that changed, or
+  /// nothing (with a warning) if the map has outgrown ~max_cross_section_cells.
+  std::optional<mvog::CellRange> updateGrid(std::size_t layer,
+                                            const std::vector<mvog::TileIndex>& changed,
+                                            bool& relaid_out);
   void sendBinaryMap(const ros::SingleSubscriberPublisher& subscriber);
   /// Forgets every published tile and grid (clearing the markers and publishing the grids as
   /// unknown): the next publication starts from scratch.

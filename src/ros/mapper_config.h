@@ -50,7 +50,7 @@ struct MapperConfig {
 
   // Service limits.
   int max_query_points = 1000000;
-  int max_cross_section_cells = 16000000;
+  int max_cross_section_cells = 16000000;  // also the largest grid published
 
   /// Throws mvog::ConfigError naming the first invalid parameter.
   void validate() const;

@@ -177,8 +177,15 @@ mvog::CellRange IncrementalGrid::update(const mvog::Map& map,
     // Re-lay out over whole tiles around the bounds plus a margin, and evaluate it all.
     const mvog::TileIndex low = mvog::Map::tileOf(bounds.min);
     const mvog::TileIndex high = mvog::Map::tileOf(bounds.max);
-    cells_ = {mvog::Map::tileCells({low.x - kMarginTiles, low.y - kMarginTiles}).min,
-              mvog::Map::tileCells({high.x + kMarginTiles, high.y + kMarginTiles}).max};
+    const mvog::CellRange layout{
+        mvog::Map::tileCells({low.x - kMarginTiles, low.y - kMarginTiles}).min,
+        mvog::Map::tileCells({high.x + kMarginTiles, high.y + kMarginTiles}).max};
+    if (layout.width() * layout.height() > max_cells_) {
+      clear();
+      throw GridTooLarge("the map's extent needs " + std::to_string(layout.width()) + " x " +
+                         std::to_string(layout.height()) + " cells");
+    }
+    cells_ = layout;
     grid_.info.resolution = static_cast<float>(map.resolution());
     grid_.info.width = static_cast<std::uint32_t>(cells_.width());
     grid_.info.height = static_cast<std::uint32_t>(cells_.height());

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,6 +41,12 @@ template <class T>
 nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::Grid2D<T>& grid, double z,
                                         const std::string& frame_id, const ros::Time& stamp);
 
+/// Thrown by IncrementalGrid::update when the map has outgrown the largest grid allowed.
+class GridTooLarge : public std::length_error {
+ public:
+  using std::length_error::length_error;
+};
+
 /// A 2D layer of the map (the projected map or one cross-section) kept up to date tile by tile.
 /// It covers whole tiles around the map's bounds, with a margin so that a growing map seldom
 /// makes it re-lay itself out.
@@ -47,10 +55,13 @@ class IncrementalGrid {
   /// compute(map, cells) evaluates the layer over a range of cells.
   using Compute = std::function<nav_msgs::OccupancyGrid::_data_type(const mvog::Map&,
                                                                    const mvog::CellRange&)>;
-  IncrementalGrid(double z, Compute compute) : z_(z), compute_(std::move(compute)) {}
+  /// A grid of at most max_cells cells.
+  IncrementalGrid(double z, std::int64_t max_cells, Compute compute)
+      : z_(z), max_cells_(max_cells), compute_(std::move(compute)) {}
 
   /// Brings the grid up to date with the tiles changed since the last update. Returns the
   /// rectangle that changed (for an OccupancyGridUpdate), or the whole grid after a re-layout.
+  /// Throws GridTooLarge (and forgets the grid) if the map's bounds need more than max_cells.
   mvog::CellRange update(const mvog::Map& map, const std::vector<mvog::TileIndex>& changed,
                          bool& relaid_out);
   /// Forgets the grid and its layout: the next update lays it out afresh.
@@ -69,6 +80,7 @@ class IncrementalGrid {
   std::ptrdiff_t indexOf(std::int64_t x, std::int64_t y) const;
 
   double z_;
+  std::int64_t max_cells_;
   Compute compute_;
   nav_msgs::OccupancyGrid grid_;
   static constexpr mvog::CellRange kNoCells{{0, 0}, {-1, -1}};
