@@ -174,28 +174,36 @@ constexpr std::size_t kWallRows = 8;
 constexpr std::size_t kNaNPointsPerCloud = 2;
 constexpr std::size_t kPointsPerCloud = kWallColumns * kWallRows + kNaNPointsPerCloud;
 
-sensor_msgs::PointCloud2 wallCloud(const ros::Time& stamp) {
+/// A cloud of the camera seeing points given in the map frame.
+sensor_msgs::PointCloud2 cameraCloud(const std::vector<Eigen::Vector3d>& map_points,
+                                     const ros::Time& stamp) {
   sensor_msgs::PointCloud2 cloud;
   cloud.header.frame_id = "camera";
   cloud.header.stamp = stamp;
   sensor_msgs::PointCloud2Modifier modifier(cloud);
   modifier.setPointCloud2FieldsByString(1, "xyz");
-  modifier.resize(kPointsPerCloud);
+  modifier.resize(map_points.size());
   sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
   const Eigen::Isometry3d camera_from_map = kMapFromCamera.inverse();
-  for (std::size_t k = 0; k < kPointsPerCloud; ++k, ++x, ++y, ++z) {
-    Eigen::Vector3d point = Eigen::Vector3d::Constant(std::nan(""));
-    if (k < kWallColumns * kWallRows) {
-      point = camera_from_map * Eigen::Vector3d(3.05,
-                                                -0.95 + 0.1 * static_cast<double>(k % kWallColumns),
-                                                1.25 + 0.1 * static_cast<double>(k / kWallColumns));
-    }
+  for (const Eigen::Vector3d& map_point : map_points) {
+    const Eigen::Vector3d point = camera_from_map * map_point;
     *x = static_cast<float>(point.x());
     *y = static_cast<float>(point.y());
     *z = static_cast<float>(point.z());
+    ++x, ++y, ++z;
   }
   cloud.is_dense = false;
   return cloud;
+}
+
+sensor_msgs::PointCloud2 wallCloud(const ros::Time& stamp) {
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t k = 0; k < kWallColumns * kWallRows; ++k) {
+    points.emplace_back(3.05, -0.95 + 0.1 * static_cast<double>(k % kWallColumns),
+                        1.25 + 0.1 * static_cast<double>(k / kWallColumns));
+  }
+  points.resize(kPointsPerCloud, Eigen::Vector3d::Constant(std::nan("")));
+  return cameraCloud(points, stamp);
 }
 
 // ---- Probes: where the answer is known --------------------------------------------------------
@@ -909,6 +917,38 @@ TEST_F(Mapper, ClearsWhatItPublishedOnResetAndStartsAfresh) {
   mapScene();
   EXPECT_TRUE(late_subscriber.waitForMessage(showsTheSceneAtLaserHeight));
   expectSceneAnswers();
+}
+
+TEST_F(Mapper, KeepsServingAMapTooWideForItsGrids) {
+  // One reading 2 km away: the grids would need 400 million cells, more than the core can
+  // evaluate and than ~max_cross_section_cells (16 million by default) allows.
+  ros::NodeHandle nh;
+  Inbox<visualization_msgs::MarkerArray> occupied(nh, server_->name() + "/occupied");
+  Inbox<nav_msgs::OccupancyGrid> projected_map(nh, server_->name() + "/projected_map");
+  mapScene();
+  const Eigen::Vector3d far_away(2000.05, 2000.05, 1.55);
+  sensors_->publisher<sensor_msgs::PointCloud2>("/cloud_in")
+      .publish(cameraCloud({far_away}, ros::Time::now()));
+  server_->waitForInsertedMessages(kScans + kClouds + 1);
+  // Its marker is published, and the grids are brought up to date right after.
+  EXPECT_TRUE(occupied.waitForAll([](const auto& all) {
+    return std::any_of(all.begin(), all.end(), [](const auto& array) {
+      return std::any_of(array->markers.begin(), array->markers.end(), [](const auto& marker) {
+        return !marker.points.empty() && marker.points[0].x > 1000.0;
+      });
+    });
+  }));
+  EXPECT_EQ(server_->state(far_away), kOccupied);
+  expectSceneAnswers();
+  for (const auto& grid : projected_map.messages()) {
+    EXPECT_LE(grid->data.size(), 16000000u);
+  }
+  mvog::GetCrossSection::Request request;
+  request.height = kLaserHeight;
+  const mvog::GetCrossSection::Response response = server_->crossSection(request);
+  EXPECT_FALSE(response.success);
+  EXPECT_NE(response.message.find("~max_cross_section_cells"), std::string::npos)
+      << response.message;
 }
 
 // ---- Decay.*: a person who walked through ------------------------------------------------------
