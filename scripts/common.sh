@@ -8,7 +8,8 @@ WORKSPACE=${MVOG_WORKSPACE:-$REPO/.ws}
 LOG_DIR=$WORKSPACE/logs
 export MVOG_DATA_DIR=${MVOG_DATA_DIR:-$(cd "$REPO/.." && pwd)/shared/data}
 
-# Debian 12 packages: ROS 1 (Debian's own build), PCL, OctoMap, test and headless-rviz tools.
+# Debian 12 packages: ROS 1 (Debian's own build), PCL, OctoMap, test and headless-rviz tools,
+# clang with its sanitizer and libFuzzer runtimes (scripts/sanitizers.sh).
 MVOG_PACKAGES=(
   build-essential cmake libeigen3-dev libgtest-dev libbenchmark-dev
   ros-core-python-dev ros-base-dev python3-rostest rosbash python3-rosbag python3-numpy
@@ -17,6 +18,7 @@ MVOG_PACKAGES=(
   libtf2-geometry-msgs-dev liblaser-geometry-dev libstd-srvs-dev libvisualization-msgs-dev
   libnav-msgs-dev libmap-msgs-dev libdiagnostic-msgs-dev rviz tf2-tools liboctomap-dev octomap-tools
   xvfb xauth x11-utils libgl1-mesa-dri imagemagick
+  clang-14 libclang-rt-14-dev
 )
 
 as_root() {

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds (Release) and runs every test: the core alone with plain CMake
-# (no ROS), then the catkin package's gtests and rostests. Prints one summary line and exits
+# (no ROS), then the catkin package's gtests and rostests, then the sanitizer builds and fuzzing
+# (scripts/sanitizers.sh). Prints one summary line and exits
 # non-zero on any failure. Tests that replay ../shared/data skip without it, but not when CI=true.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
@@ -41,6 +42,18 @@ failed=$((failed + errors + test_failures))
 skipped=$((skipped + test_skipped))
 if [ $((errors + test_failures)) -gt 0 ] || [ "$tests" -eq 0 ]; then
   failures+=("catkin tests: $(grep -vE '^Summary:' <<<"$results" | grep -E 'errors|failures|Error' | head -20)")
+fi
+
+# 3. Sanitizer builds and fuzzing: ASan + UBSan, TSan, libFuzzer (scripts/sanitizers.sh).
+bash "$REPO/scripts/sanitizers.sh" >"$LOG_DIR/sanitizers.log" 2>&1 || true
+sanitizer_counts=$(sed -nE 's/^sanitizers: ([0-9]+) passed, ([0-9]+) failed, ([0-9]+) skipped$/\1 \2 \3/p' \
+  "$LOG_DIR/sanitizers.log")
+read -r san_passed san_failed san_skipped <<<"${sanitizer_counts:-0 1 0}"
+passed=$((passed + san_passed))
+failed=$((failed + san_failed))
+skipped=$((skipped + san_skipped))
+if [ "$san_failed" -gt 0 ]; then
+  failures+=("sanitizers: $(grep -E '^FAILED' "$LOG_DIR/sanitizers.log" | head -10) (log: $LOG_DIR/sanitizers.log)")
 fi
 
 for failure in "${failures[@]}"; do echo "FAILED: $failure"; done

@@ -1,0 +1,135 @@
+#!/usr/bin/env python3
+"""Writes the seed corpora of the fuzz targets (test/fuzz/corpus/<target>/), deterministically.
+
+map_file: maps in the format of include/mvog/map_io.h (valid ones, and a few refused ones).
+conversions: inputs in the layout documented at the top of test/fuzz/fuzz_conversions.cpp.
+Run it again after changing either format; the files are small and committed.
+"""
+import math
+import os
+import struct
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+NAN = float('nan')
+INF = float('inf')
+
+
+def fnv1a64(data):
+    h = 0xcbf29ce484222325
+    for b in data:
+        h ^= b
+        h = (h * 0x100000001b3) & 0xFFFFFFFFFFFFFFFF
+    return h
+
+
+def map_file(cells, resolution=0.1, max_coordinate=10000.0, version=1):
+    """cells: [(x, y, [(bottom, top, mass)...positive], [(...)...negative])]"""
+    volumes = sum(len(p) + len(n) for _, _, p, n in cells)
+    out = b'MVOGMAP\0' + struct.pack('<IIddQQQQ', version, 64, resolution, max_coordinate,
+                                     len(cells), volumes, 0, 0)
+    for x, y, positive, negative in cells:
+        out += struct.pack('<iiII', x, y, len(positive), len(negative))
+        for bottom, top, mass in positive + negative:
+            out += struct.pack('<fff', bottom, top, mass)
+    return out + struct.pack('<Q', fnv1a64(out))
+
+
+def pose(x=0.0, y=0.0, z=0.0, roll=0.0, pitch=0.0, yaw=0.0):
+    return struct.pack('<6f', x, y, z, roll, pitch, yaw)
+
+
+def scan(ranges, angle_min=0.0, angle_increment=math.pi / 2, range_min=0.1, range_max=10.0,
+         max_free_range=0.0, beams=None, intensities=0, options=1, sensor=None):
+    beams = len(ranges) if beams is None else beams
+    out = struct.pack('<BB', 0, options) + (sensor or pose(0.5, -0.5, 1.0, 0.0, 0.1, 0.3))
+    out += struct.pack('<6f', angle_min, angle_min + angle_increment * max(beams - 1, 0),
+                       angle_increment, range_min, range_max, max_free_range)
+    out += struct.pack('<IH', beams, intensities)
+    return out + struct.pack('<%df' % len(ranges), *ranges)
+
+
+FLOAT32, FLOAT64, INT32 = 7, 8, 5
+NAMES = {'x': 0, 'y': 1, 'z': 2, 'rgb': 3, 'intensity': 4, 'xx': 5}
+
+
+def cloud(points, fields, point_step, width, row_padding=0, big_endian=False, options=1,
+          sensor=None, height=None, data=None):
+    height = len(points) // width if height is None else height
+    row_step = (point_step * width + row_padding) & 0xFFFFFFFF
+    out = struct.pack('<BB', 1, options) + (sensor or pose(0.0, 0.0, 1.2, 0.0, 0.0, 1.0))
+    out += struct.pack('<BIIIIB', 1 if big_endian else 0, height, width, point_step, row_step,
+                       len(fields))
+    for name, offset, datatype in fields:
+        out += struct.pack('<BIBI', NAMES[name], offset, datatype, 1)
+    if data is None:
+        body = bytearray(b'\xab' * (row_step * height))
+        order = '>' if big_endian else '<'
+        for k, point in enumerate(points):
+            start = (k // width) * row_step + (k % width) * point_step
+            for name, offset, datatype in fields:
+                if name not in 'xyz' or len(name) != 1:
+                    continue
+                value = point['xyz'.index(name)]
+                code = 'd' if datatype == FLOAT64 else 'f'
+                size = 8 if datatype == FLOAT64 else 4
+                body[start + offset:start + offset + size] = struct.pack(order + code, value)
+        data = bytes(body)
+    return out + data
+
+
+XYZ32 = [('x', 0, FLOAT32), ('y', 4, FLOAT32), ('z', 8, FLOAT32)]
+
+
+def main():
+    maps = {
+        'empty.mvog': map_file([]),
+        'one_volume.mvog': map_file([(0, 0, [(0.0, 1.0, 1.0)], [])]),
+        'two_cells.mvog': map_file([(0, 0, [(2.0, 3.0, 1.0)], [(-1.0, 1.5, 2.5)]),
+                                    (-5, 7, [], [(0.0, 4.0, 4.0), (6.0, 8.0, 2.0)])]),
+        'coarse_far.mvog': map_file([(99, -100, [(-3.0, -1.5, 0.5)], [(10.0, 12.0, 2.0)])],
+                                    resolution=1.0, max_coordinate=100.0),
+        'decayed.mvog': map_file([(3, 4, [(0.5, 1.5, 1e-30)], [(-4.0, 0.0, 3e-31)]),
+                                  (4, 4, [(0.0, 1.0, 0.0)], [])]),
+        'refused_checksum.mvog': map_file([(0, 0, [(0.0, 1.0, 1.0)], [])])[:-1] + b'\0',
+        'refused_version.mvog': map_file([], version=2),
+    }
+    for name, data in maps.items():
+        with open(os.path.join(HERE, 'corpus', 'map_file', name), 'wb') as f:
+            f.write(data)
+
+    far = 1e7  # 10,000 km
+    inputs = {
+        'scan_four_beams': scan([1.0, 2.0, 0.5, 10.0]),
+        'scan_special_ranges': scan([NAN, INF, -INF, -1.0, 0.05, 1e30, 3.0, 12.0],
+                                    angle_increment=0.2, max_free_range=4.0),
+        'scan_one_beam_no_increment': scan([2.0], angle_increment=0.0),
+        'scan_negative_increment': scan([1.0, 1.5, 2.0], angle_min=1.0, angle_increment=-0.5,
+                                        options=1 | 2 | 8),
+        'scan_bad_limits': scan([1.0, 1.0], range_min=5.0, range_max=1.0),
+        'scan_nan_angle': scan([1.0, 1.0], angle_min=NAN),
+        'scan_no_beams': scan([]),
+        'scan_many_beams_few_bytes': scan([1.5], beams=3000, angle_increment=1e-3, options=0),
+        'scan_intensities_mismatch': scan([1.0, 2.0, 3.0], intensities=7, angle_increment=0.1),
+        'cloud_xyz32': cloud([(1.0, 2.0, 0.5), (3.0, -1.0, 1.5), (0.5, 0.5, 0.0),
+                              (-2.0, -2.0, 2.0)], XYZ32, 12, 4),
+        'cloud_float64_bigendian_padded': cloud(
+            [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (1.0, 1.0, 1.0)],
+            [('rgb', 0, FLOAT32), ('x', 5, FLOAT64), ('y', 13, FLOAT64), ('z', 21, FLOAT32)],
+            32, 2, row_padding=3, big_endian=True, options=1 | 4),
+        'cloud_nan_and_far_points': cloud([(NAN, 0.0, 0.0), (INF, 1.0, 1.0), (far, far, 0.0),
+                                           (2.0, 2.0, 1.0)], XYZ32, 12, 4),
+        'cloud_integer_fields': cloud([(1.0, 1.0, 1.0)], [('x', 0, INT32), ('y', 4, INT32),
+                                                          ('z', 8, INT32)], 12, 1),
+        'cloud_missing_z': cloud([(1.0, 1.0, 1.0)], XYZ32[:2], 12, 1),
+        'cloud_field_beyond_step': cloud([(1.0, 1.0, 1.0)], XYZ32, 8, 1, data=b'\0' * 12),
+        'cloud_short_data': cloud([], XYZ32, 12, 100, height=100, data=b'\0' * 120),
+        'cloud_absurd_size': cloud([], XYZ32, 12, 0xFFFFFFFF, height=0xFFFFFFFF, data=b''),
+        'cloud_empty': cloud([], XYZ32, 12, 0, height=0, data=b''),
+    }
+    for name, data in inputs.items():
+        with open(os.path.join(HERE, 'corpus', 'conversions', name), 'wb') as f:
+            f.write(data)
+
+
+if __name__ == '__main__':
+    main()
