@@ -79,10 +79,11 @@ if build fuzz clang++-14 fuzz_map_file fuzz_conversions; then
   for target in map_file conversions; do
     # New inputs go to the first directory (kept between local runs); the others only seed.
     mkdir -p "$BUILD_ROOT/fuzz/corpus/$target"
+    seeds=("$REPO/test/fuzz/corpus/$target")
+    [ -d "$REPO/test/fuzz/regressions/$target" ] && seeds+=("$REPO/test/fuzz/regressions/$target")
     check "fuzz-$target" "$BUILD_ROOT/fuzz/fuzz_$target" -max_total_time="$FUZZ_SECONDS" \
       -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
-      -artifact_prefix="$FUZZ_LOGS/$target-" "$BUILD_ROOT/fuzz/corpus/$target" \
-      "$REPO/test/fuzz/corpus/$target" "$REPO/test/fuzz/regressions/$target"
+      -artifact_prefix="$FUZZ_LOGS/$target-" "$BUILD_ROOT/fuzz/corpus/$target" "${seeds[@]}"
   done
 else
   fail "fuzz-map_file: the fuzz build failed"
