@@ -66,23 +66,21 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
   occupied_publisher_ = marker_publisher("occupied", true);
 
   const std::int64_t max_grid_cells = config_.max_cross_section_cells;
-  grids_.emplace_back(config_.projection_min_z, max_grid_cells,
-                      [this](const mvog::Map& map, const mvog::CellRange& cells) {
-                        return toOccupancyGrid(map.projection(config_.projection_min_z,
-                                                              config_.projection_max_z,
-                                                              config_.occupancy_threshold, cells),
-                                               0.0, "", ros::Time())
-                            .data;
-                      });
+  grids_.emplace_back(
+      config_.projection_min_z, max_grid_cells,
+      [this](const mvog::Map& map, const mvog::CellRange& cells) {
+        return toOccupancyGrid(map.projection(config_.projection_min_z, config_.projection_max_z,
+                                              config_.occupancy_threshold, cells),
+                               0.0, "", ros::Time())
+            .data;
+      });
   std::vector<std::string> grid_topics{"projected_map"};
   for (std::size_t k = 0; k < config_.cross_section_heights.size(); ++k) {
     const double height = config_.cross_section_heights[k];
-    grids_.emplace_back(height, max_grid_cells,
-                        [height](const mvog::Map& map, const mvog::CellRange& cells) {
-                          return toOccupancyGrid(map.crossSection(height, cells), height, "",
-                                                 ros::Time())
-                              .data;
-                        });
+    grids_.emplace_back(
+        height, max_grid_cells, [height](const mvog::Map& map, const mvog::CellRange& cells) {
+          return toOccupancyGrid(map.crossSection(height, cells), height, "", ros::Time()).data;
+        });
     grid_topics.push_back("cross_section_" + std::to_string(k));
     ROS_INFO("mvog: ~%s is the cross-section at z = %.3f m", grid_topics.back().c_str(), height);
   }
@@ -105,20 +103,20 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
   services_.push_back(private_nh_.advertiseService("load_map", &Mapper::loadMap, this));
   services_.push_back(private_nh_.advertiseService("reset", &Mapper::reset, this));
 
-  timers_.push_back(nh_.createTimer(ros::Duration(config_.publish_period), &Mapper::publishChanges,
-                                    this));
-  timers_.push_back(nh_.createTimer(ros::Duration(config_.statistics_period),
-                                    &Mapper::publishStatistics, this));
+  timers_.push_back(
+      nh_.createTimer(ros::Duration(config_.publish_period), &Mapper::publishChanges, this));
+  timers_.push_back(
+      nh_.createTimer(ros::Duration(config_.statistics_period), &Mapper::publishStatistics, this));
   if (config_.binary_map_period > 0.0) {
-    timers_.push_back(nh_.createTimer(ros::Duration(config_.binary_map_period),
-                                      &Mapper::publishBinaryMap, this));
+    timers_.push_back(
+        nh_.createTimer(ros::Duration(config_.binary_map_period), &Mapper::publishBinaryMap, this));
   }
   if (config_.decay_period > 0.0 && config_.decay_factor < 1.0) {
     timers_.push_back(nh_.createTimer(ros::Duration(config_.decay_period), &Mapper::decay, this));
   }
   if (config_.autosave_period > 0.0) {
-    timers_.push_back(nh_.createTimer(ros::Duration(config_.autosave_period), &Mapper::autosave,
-                                      this));
+    timers_.push_back(
+        nh_.createTimer(ros::Duration(config_.autosave_period), &Mapper::autosave, this));
   }
   last_statistics_time_ = ros::WallTime::now();
   insertion_thread_ = std::thread(&Mapper::insertionLoop, this);
@@ -225,10 +223,10 @@ void Mapper::insertScan(const sensor_msgs::LaserScan& scan,
                         const Eigen::Isometry3d& map_from_sensor) {
   try {
     std::size_t skipped = 0;
-    PendingScan pending{scanToReadings(scan, map_from_sensor, config_.insertion.max_range,
-                                       static_cast<std::size_t>(config_.max_points_per_message),
-                                       skipped),
-                        "LaserScan"};
+    PendingScan pending{
+        scanToReadings(scan, map_from_sensor, config_.insertion.max_range,
+                       static_cast<std::size_t>(config_.max_points_per_message), skipped),
+        "LaserScan"};
     counters_.readings_rejected += skipped;
     enqueue(std::move(pending));
   } catch (const InvalidMessage& e) {
@@ -239,10 +237,9 @@ void Mapper::insertScan(const sensor_msgs::LaserScan& scan,
 void Mapper::insertCloud(const sensor_msgs::PointCloud2& cloud,
                          const Eigen::Isometry3d& map_from_sensor) {
   try {
-    PendingScan pending{
-        cloudToReadings(cloud, map_from_sensor,
-                        static_cast<std::size_t>(config_.max_points_per_message)),
-        "PointCloud2"};
+    PendingScan pending{cloudToReadings(cloud, map_from_sensor,
+                                        static_cast<std::size_t>(config_.max_points_per_message)),
+                        "PointCloud2"};
     if (config_.voxel_filter_size > 0.0) {
       counters_.readings_rejected += voxelFilter(pending.scan.hits, config_.voxel_filter_size);
     }
@@ -284,10 +281,10 @@ void Mapper::insertionLoop() {
       std::unique_lock<std::shared_mutex> lock(map_mutex_);
       result = map_.insertScan(pending.scan, config_.insertion);
     }
-    counters_.insertion_nanoseconds += static_cast<std::uint64_t>(
-        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() -
-                                                             start)
-            .count());
+    counters_.insertion_nanoseconds +=
+        static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                       std::chrono::steady_clock::now() - start)
+                                       .count());
     counters_.readings_inserted += result.inserted();
     counters_.readings_rejected += result.rejected();
     ++counters_.messages_inserted;
@@ -387,34 +384,28 @@ std::optional<mvog::CellRange> Mapper::updateGrid(std::size_t layer,
   }
 }
 
-void Mapper::sendBinaryMap(const ros::SingleSubscriberPublisher& subscriber) {
+mvog::MapBinary Mapper::binaryMapMessage() const {
   mvog::MapBinary message;
-  {
-    std::shared_lock<std::shared_mutex> lock(map_mutex_);
-    message.data = mvog::serializeMap(map_);
-    message.resolution = map_.resolution();
-  }
+  message.data = mvog::serializeMap(map_);
+  message.resolution = map_.resolution();
   message.header.frame_id = config_.frame_id;
   message.header.stamp = ros::Time::now();
   message.format_version = mvog::kMapFormatVersion;
-  subscriber.publish(message);
+  return message;
+}
+
+void Mapper::sendBinaryMap(const ros::SingleSubscriberPublisher& subscriber) {
+  std::shared_lock<std::shared_mutex> lock(map_mutex_);
+  subscriber.publish(binaryMapMessage());
 }
 
 void Mapper::publishBinaryMap(const ros::TimerEvent&) {
   if (binary_map_publisher_.getNumSubscribers() == 0) return;
-  mvog::MapBinary message;
-  {
-    std::lock_guard<std::mutex> publish_lock(publish_mutex_);
-    std::shared_lock<std::shared_mutex> lock(map_mutex_);
-    if (map_.revision() == binary_revision_) return;
-    binary_revision_ = map_.revision();
-    message.data = mvog::serializeMap(map_);
-    message.resolution = map_.resolution();
-  }
-  message.header.frame_id = config_.frame_id;
-  message.header.stamp = ros::Time::now();
-  message.format_version = mvog::kMapFormatVersion;
-  binary_map_publisher_.publish(message);
+  std::lock_guard<std::mutex> publish_lock(publish_mutex_);
+  std::shared_lock<std::shared_mutex> lock(map_mutex_);
+  if (map_.revision() == binary_revision_) return;
+  binary_revision_ = map_.revision();
+  binary_map_publisher_.publish(binaryMapMessage());
 }
 
 void Mapper::publishStatistics(const ros::TimerEvent&) {
@@ -435,8 +426,7 @@ void Mapper::publishStatistics(const ros::TimerEvent&) {
   const double elapsed = (now - last_statistics_time_).toSec();
   if (elapsed > 0.0 && statistics.readings_inserted >= readings_at_last_statistics_) {
     statistics.readings_per_second =
-        static_cast<double>(statistics.readings_inserted - readings_at_last_statistics_) /
-        elapsed;
+        static_cast<double>(statistics.readings_inserted - readings_at_last_statistics_) / elapsed;
   }
   readings_at_last_statistics_ = statistics.readings_inserted;
   last_statistics_time_ = now;

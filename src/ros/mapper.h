@@ -12,17 +12,18 @@
 #include <thread>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+#include <Eigen/Geometry>
 
 #include "mapper_config.h"
 #include "mvog/GetCrossSection.h"
 #include "mvog/GetOccupancy.h"
+#include "mvog/MapBinary.h"
 #include "mvog/MapFile.h"
 #include "mvog/map.h"
 #include "visualization.h"
@@ -81,8 +82,7 @@ class Mapper {
   void retryWaitingMessages(const ros::TimerEvent&);
   void dropForTransform(const std_msgs::Header& header, const std::string& why);
   void insertScan(const sensor_msgs::LaserScan& scan, const Eigen::Isometry3d& map_from_sensor);
-  void insertCloud(const sensor_msgs::PointCloud2& cloud,
-                   const Eigen::Isometry3d& map_from_sensor);
+  void insertCloud(const sensor_msgs::PointCloud2& cloud, const Eigen::Isometry3d& map_from_sensor);
   void rejectMessage(const std::string& topic_kind, const std::string& why);
   void enqueue(PendingScan&& pending);
   void insertionLoop();
@@ -100,6 +100,8 @@ class Mapper {
                                             const std::vector<mvog::TileIndex>& changed,
                                             bool& relaid_out);
   void sendBinaryMap(const ros::SingleSubscriberPublisher& subscriber);
+  /// The whole map as a ~map message; the caller holds the map lock (shared).
+  mvog::MapBinary binaryMapMessage() const;
   /// Forgets every published tile and grid (clearing the markers and publishing the grids as
   /// unknown): the next publication starts from scratch.
   void restartPublication();
