@@ -78,10 +78,11 @@ rosparam set /mvog_mapper/cross_section_heights "$heights_yaml" 2>/dev/null || t
 
 screenshot=""
 if command -v Xvfb >/dev/null && command -v rviz >/dev/null; then
-  display=:$((90 + port % 100))
-  Xvfb "$display" -screen 0 1280x900x24 >"$LOG_DIR/demo-xvfb.log" 2>&1 &
+  # Xvfb picks a free display itself and writes its number to the file descriptor given.
+  Xvfb -displayfd 3 -screen 0 1280x900x24 3>"$output/.xvfb-display" >"$LOG_DIR/demo-xvfb.log" 2>&1 &
   pids+=($!)
-  sleep 1
+  for _ in $(seq 50); do [ -s "$output/.xvfb-display" ] && break; sleep 0.2; done
+  display=:$(cat "$output/.xvfb-display")
   DISPLAY=$display rviz -d "$REPO/rviz/mvog.rviz" >"$LOG_DIR/demo-rviz.log" 2>&1 &
   pids+=($!)
 fi
@@ -110,7 +111,8 @@ fi
 export_args=()
 for z in $heights; do export_args+=(--cross-section "$z" "$output/cross_section_${z}m"); done
 export_args+=(--projection 0.1 2.0 "$output/projected_map" --render "$output/occupied.png")
-rosrun mvog mvog_export "$map" "${export_args[@]}" >"$LOG_DIR/demo-export.log"
+# By path: rosrun searches the package directory, which holds the workspace's link back to it.
+"$WORKSPACE/devel/lib/mvog/mvog_export" "$map" "${export_args[@]}" >"$LOG_DIR/demo-export.log"
 
 echo
 echo "statistics:"
