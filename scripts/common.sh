@@ -4,7 +4,9 @@ set -euo pipefail
 # Debian's python3 must come first: a pyenv python3 breaks catkin, pluginlib, rosrun and rostest.
 export PATH=/usr/bin:$PATH
 REPO=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-WORKSPACE=${MVOG_WORKSPACE:-$REPO/.ws}
+# The workspace lives outside the repository: inside it, the workspace's link back to the package
+# would make a loop for tools that search the package directory (rosrun). One per clone.
+WORKSPACE=${MVOG_WORKSPACE:-${XDG_CACHE_HOME:-$HOME/.cache}/mvog/ws-$(printf %s "$REPO" | md5sum | cut -c1-8)}
 LOG_DIR=$WORKSPACE/logs
 export MVOG_DATA_DIR=${MVOG_DATA_DIR:-$(cd "$REPO/.." && pwd)/shared/data}
 
