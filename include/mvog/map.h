@@ -26,10 +26,18 @@ struct Scan {
   std::vector<Eigen::Vector3f> free_endpoints;
 };
 
+/// Splits `scan` into consecutive pieces of at most `max_readings` readings each (its hits, then
+/// its free endpoints, in order), all from its origin. Inserting the pieces in order builds the
+/// same map as inserting `scan`, since the readings go in in the same order; not so with
+/// InsertionConfig::clear_conflicting_free_space, whose conflicts are those within one scan.
+/// A server inserts a large cloud piece by piece so that queries get the map in between.
+/// An empty scan has no piece. Throws ConfigError if `max_readings` is 0.
+std::vector<Scan> splitScan(const Scan& scan, std::size_t max_readings);
+
 /// What happened to the readings given to an insertion. Every reading is counted exactly once.
 struct InsertionResult {
-  std::size_t obstacle_readings = 0;      ///< inserted with a positive volume
-  std::size_t out_of_range_readings = 0;  ///< inserted as free space only (incl. truncated hits)
+  std::size_t obstacle_readings = 0;       ///< inserted with a positive volume
+  std::size_t out_of_range_readings = 0;   ///< inserted as free space only (incl. truncated hits)
   std::size_t truncated_to_max_range = 0;  ///< hits beyond max_range, among out_of_range_readings
   std::size_t rejected_non_finite = 0;     ///< NaN or infinite coordinates
   std::size_t rejected_out_of_bounds = 0;  ///< beyond MapConfig::max_coordinate
@@ -81,7 +89,9 @@ struct MemoryUsage {
 struct TileIndex {
   std::int32_t x = 0;
   std::int32_t y = 0;
-  friend bool operator==(const TileIndex& a, const TileIndex& b) { return a.x == b.x && a.y == b.y; }
+  friend bool operator==(const TileIndex& a, const TileIndex& b) {
+    return a.x == b.x && a.y == b.y;
+  }
 };
 
 /// A Multi-Volume Occupancy Grid (Dryanovski, Morris, Xiao, IROS 2010).
@@ -134,12 +144,12 @@ class Map {
   CellRange cellsInRectangle(double min_x, double min_y, double max_x, double max_y) const;
 
   /// Calls visit(CellIndex, VolumeSign, const Volume&) for every volume (masses as of now).
-  void forEachVolume(const std::function<void(const CellIndex&, VolumeSign, const Volume&)>& visit)
-      const;
+  void forEachVolume(
+      const std::function<void(const CellIndex&, VolumeSign, const Volume&)>& visit) const;
   /// Same, restricted to the cells of `cells`.
-  void forEachVolumeIn(const CellRange& cells,
-                       const std::function<void(const CellIndex&, VolumeSign, const Volume&)>&
-                           visit) const;
+  void forEachVolumeIn(
+      const CellRange& cells,
+      const std::function<void(const CellIndex&, VolumeSign, const Volume&)>& visit) const;
 
   // ---- Decay (Sec. III-E) -----------------------------------------------------------------
 

@@ -179,6 +179,33 @@ struct Map::Tile {
 
 // ---- InsertionResult / PointOccupancy --------------------------------------------------------
 
+std::vector<Scan> splitScan(const Scan& scan, std::size_t max_readings) {
+  if (max_readings == 0) throw ConfigError("max_readings: must be >= 1");
+  std::vector<Scan> pieces;
+  auto piece_with_room = [&]() -> Scan& {
+    if (pieces.empty() ||
+        pieces.back().hits.size() + pieces.back().free_endpoints.size() == max_readings) {
+      pieces.emplace_back().origin = scan.origin;
+    }
+    return pieces.back();
+  };
+  for (std::size_t next = 0; next < scan.hits.size();) {
+    Scan& piece = piece_with_room();
+    const std::size_t count = std::min(max_readings - piece.hits.size(), scan.hits.size() - next);
+    piece.hits.assign(scan.hits.begin() + next, scan.hits.begin() + next + count);
+    next += count;
+  }
+  for (std::size_t next = 0; next < scan.free_endpoints.size();) {
+    Scan& piece = piece_with_room();
+    const std::size_t room = max_readings - piece.hits.size() - piece.free_endpoints.size();
+    const std::size_t count = std::min(room, scan.free_endpoints.size() - next);
+    piece.free_endpoints.insert(piece.free_endpoints.end(), scan.free_endpoints.begin() + next,
+                                scan.free_endpoints.begin() + next + count);
+    next += count;
+  }
+  return pieces;
+}
+
 InsertionResult& InsertionResult::operator+=(const InsertionResult& other) {
   obstacle_readings += other.obstacle_readings;
   out_of_range_readings += other.out_of_range_readings;

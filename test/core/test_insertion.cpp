@@ -393,6 +393,52 @@ TEST(Insertion, ScanEqualsReadingByReading) {
   EXPECT_LT(by_scan.bounds().min.y, 0);
 }
 
+TEST(Insertion, SplitScanPiecesInsertedInOrderBuildTheSameMap) {
+  MapConfig map_config;
+  map_config.resolution = 0.25;
+  std::mt19937 rng(5);
+  const Scan scan = test::randomScan(rng, {0.5, -1.0, 0.25}, 2000, 1000, 20.0);
+  // 700 does not divide 2000: one piece holds the last hits and the first free endpoints.
+  const std::vector<Scan> pieces = splitScan(scan, 700);
+  ASSERT_EQ(pieces.size(), 5u);
+  std::vector<Eigen::Vector3f> hits;
+  std::vector<Eigen::Vector3f> free_endpoints;
+  for (const Scan& piece : pieces) {
+    EXPECT_EQ(piece.origin, scan.origin);
+    EXPECT_LE(piece.hits.size() + piece.free_endpoints.size(), 700u);
+    hits.insert(hits.end(), piece.hits.begin(), piece.hits.end());
+    free_endpoints.insert(free_endpoints.end(), piece.free_endpoints.begin(),
+                          piece.free_endpoints.end());
+  }
+  EXPECT_EQ(pieces[2].hits.size(), 600u);
+  EXPECT_EQ(pieces[2].free_endpoints.size(), 100u);
+  EXPECT_EQ(hits, scan.hits);
+  EXPECT_EQ(free_endpoints, scan.free_endpoints);
+
+  Map whole(map_config);
+  Map piece_by_piece(map_config);
+  InsertionConfig config;
+  config.max_range = 15.0;
+  const InsertionResult whole_result = whole.insertScan(scan, config);
+  InsertionResult pieces_result;
+  for (const Scan& piece : pieces) pieces_result += piece_by_piece.insertScan(piece, config);
+  EXPECT_EQ(pieces_result.obstacle_readings, whole_result.obstacle_readings);
+  EXPECT_EQ(pieces_result.out_of_range_readings, whole_result.out_of_range_readings);
+  EXPECT_EQ(pieces_result.rejected(), whole_result.rejected());
+  EXPECT_TRUE(test::sameVolumes(allVolumes(piece_by_piece), allVolumes(whole)));
+}
+
+TEST(Insertion, SplitScanEdgeCases) {
+  EXPECT_TRUE(splitScan(Scan{}, 10).empty());
+  Scan scan;
+  scan.free_endpoints.assign(3, Eigen::Vector3f(1, 2, 3));
+  const std::vector<Scan> pieces = splitScan(scan, 1);
+  ASSERT_EQ(pieces.size(), 3u);
+  EXPECT_TRUE(pieces[0].hits.empty());
+  EXPECT_EQ(pieces[0].free_endpoints.size(), 1u);
+  EXPECT_THROW(splitScan(scan, 0), ConfigError);
+}
+
 TEST(Insertion, ThreadsBuildTheSameMap) {
   // A scan of 9000 readings (more than one internal chunk of 8192) and two smaller ones, over
   // about 8 x 8 tiles around the origin, into maps built with 1 to 4 threads: identical volumes,
