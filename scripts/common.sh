@@ -65,3 +65,22 @@ source_workspace() {
   source "$WORKSPACE/devel/setup.bash"
   set -u
 }
+
+# A private ROS master on a free port (its log in $LOG_DIR/$1-roscore.log). Every process started
+# in the background and added to BACKGROUND_PIDS is stopped on exit, whatever happens.
+BACKGROUND_PIDS=()
+stop_background_processes() {
+  for pid in "${BACKGROUND_PIDS[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
+  sleep 1
+  for pid in "${BACKGROUND_PIDS[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
+}
+start_private_master() {
+  local port
+  port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+  export ROS_MASTER_URI=http://127.0.0.1:$port ROS_IP=127.0.0.1
+  trap stop_background_processes EXIT
+  mkdir -p "$LOG_DIR"
+  roscore -p "$port" >"$LOG_DIR/$1-roscore.log" 2>&1 &
+  BACKGROUND_PIDS+=($!)
+  until rosparam list >/dev/null 2>&1; do sleep 0.5; done
+}

@@ -47,27 +47,15 @@ if [ -z "$bag" ]; then
   fi
 fi
 
-# A private ROS master and X display, stopped on exit whatever happens.
-port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI=http://127.0.0.1:$port ROS_IP=127.0.0.1
-pids=()
-cleanup() {
-  for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
-  sleep 1
-  for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
-}
-trap cleanup EXIT
-roscore -p "$port" >"$LOG_DIR/demo-roscore.log" 2>&1 &
-pids+=($!)
-until rosparam list >/dev/null 2>&1; do sleep 0.5; done
+start_private_master demo
 
 heights_yaml="[$(tr -s ' ' ',' <<<"$heights")]"
 roslaunch mvog mapper.launch use_sim_time:=true resolution:="$resolution" \
   scan_topic:="$scan_topic" cloud_topic:="$cloud_topic" map_directory:="$output" \
   config:="$config" >"$LOG_DIR/demo-mapper.log" 2>&1 &
-pids+=($!)
+BACKGROUND_PIDS+=($!)
 until rosservice list 2>/dev/null | grep -q /mvog_mapper/save_map; do
-  if ! kill -0 "${pids[-1]}" 2>/dev/null; then
+  if ! kill -0 "${BACKGROUND_PIDS[-1]}" 2>/dev/null; then
     echo "the mapper did not start:" >&2
     tail -n 20 "$LOG_DIR/demo-mapper.log" >&2
     exit 1
@@ -80,11 +68,11 @@ screenshot=""
 if command -v Xvfb >/dev/null && command -v rviz >/dev/null; then
   # Xvfb picks a free display itself and writes its number to the file descriptor given.
   Xvfb -displayfd 3 -screen 0 1280x900x24 3>"$output/.xvfb-display" >"$LOG_DIR/demo-xvfb.log" 2>&1 &
-  pids+=($!)
+  BACKGROUND_PIDS+=($!)
   for _ in $(seq 50); do [ -s "$output/.xvfb-display" ] && break; sleep 0.2; done
   display=:$(cat "$output/.xvfb-display")
   DISPLAY=$display rviz -d "$REPO/rviz/mvog.rviz" >"$LOG_DIR/demo-rviz.log" 2>&1 &
-  pids+=($!)
+  BACKGROUND_PIDS+=($!)
 fi
 
 echo "replaying $bag ..."
@@ -102,7 +90,7 @@ rosservice call /mvog_mapper/save_map "path: 'demo.mvog'" >"$LOG_DIR/demo-save.l
 grep -q 'success: True' "$LOG_DIR/demo-save.log" || { cat "$LOG_DIR/demo-save.log"; exit 1; }
 map=$output/demo.mvog
 
-if [ ${#pids[@]} -gt 2 ] && DISPLAY=$display xwininfo -root >/dev/null 2>&1; then
+if [ ${#BACKGROUND_PIDS[@]} -gt 2 ] && DISPLAY=$display xwininfo -root >/dev/null 2>&1; then
   sleep 3
   DISPLAY=$display import -window root "$output/rviz.png" 2>>"$LOG_DIR/demo-screenshot.log" &&
     screenshot=$output/rviz.png
@@ -111,8 +99,7 @@ fi
 export_args=()
 for z in $heights; do export_args+=(--cross-section "$z" "$output/cross_section_${z}m"); done
 export_args+=(--projection 0.1 2.0 "$output/projected_map" --render "$output/occupied.png")
-# By path: rosrun searches the package directory, which holds the workspace's link back to it.
-"$WORKSPACE/devel/lib/mvog/mvog_export" "$map" "${export_args[@]}" >"$LOG_DIR/demo-export.log"
+rosrun mvog mvog_export "$map" "${export_args[@]}" >"$LOG_DIR/demo-export.log"
 
 echo
 echo "statistics:"
