@@ -10,7 +10,9 @@ struct CellIndex {
   std::int32_t x = 0;
   std::int32_t y = 0;
 
-  friend bool operator==(const CellIndex& a, const CellIndex& b) { return a.x == b.x && a.y == b.y; }
+  friend bool operator==(const CellIndex& a, const CellIndex& b) {
+    return a.x == b.x && a.y == b.y;
+  }
   friend bool operator!=(const CellIndex& a, const CellIndex& b) { return !(a == b); }
 };
 

@@ -35,10 +35,10 @@ void walkRay(double start_x, double start_y, double start_z, double end_x, doubl
   long remaining_x = std::labs(long{end_cell.x} - cell.x);
   long remaining_y = std::labs(long{end_cell.y} - cell.y);
   // Ray parameter t in [0, 1] at which the next x (y) wall is reached, and between two walls.
-  double t_next_x = remaining_x > 0 ? ((step_x > 0 ? cell.x + 1.0 : double(cell.x)) - start_x) / dx
-                                    : kInf;
-  double t_next_y = remaining_y > 0 ? ((step_y > 0 ? cell.y + 1.0 : double(cell.y)) - start_y) / dy
-                                    : kInf;
+  double t_next_x =
+      remaining_x > 0 ? ((step_x > 0 ? cell.x + 1.0 : double(cell.x)) - start_x) / dx : kInf;
+  double t_next_y =
+      remaining_y > 0 ? ((step_y > 0 ? cell.y + 1.0 : double(cell.y)) - start_y) / dy : kInf;
   const double t_delta_x = remaining_x > 0 ? 1.0 / std::fabs(dx) : kInf;
   const double t_delta_y = remaining_y > 0 ? 1.0 / std::fabs(dy) : kInf;
 

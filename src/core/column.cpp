@@ -20,10 +20,10 @@ std::vector<ColumnSegment> columnProfile(const CellVolumes& volumes) {
   for (std::size_t k = 0; k + 1 < heights.size(); ++k) {
     // Between two consecutive boundaries every point lies in the same volumes as the middle.
     const float middle = 0.5f * (heights[k] + heights[k + 1]);
-    const Volume* positive = findVolume(volumes.positive.data(),
-                                        static_cast<std::uint32_t>(volumes.positive.size()), middle);
-    const Volume* negative = findVolume(volumes.negative.data(),
-                                        static_cast<std::uint32_t>(volumes.negative.size()), middle);
+    const Volume* positive = findVolume(
+        volumes.positive.data(), static_cast<std::uint32_t>(volumes.positive.size()), middle);
+    const Volume* negative = findVolume(
+        volumes.negative.data(), static_cast<std::uint32_t>(volumes.negative.size()), middle);
     const float rho_plus = positive != nullptr ? positive->density() : 0.0f;
     const float rho_minus = negative != nullptr ? negative->density() : 0.0f;
     if (!(rho_plus + rho_minus > 0.0f)) continue;  // a gap between volumes: unknown

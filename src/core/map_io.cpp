@@ -112,8 +112,8 @@ std::vector<std::uint8_t> serializeMap(const Map& map) {
   });
 
   std::vector<std::uint8_t> out;
-  out.reserve(kMapHeaderBytes + kCellRecordBytes * cells.size() +
-              sizeof(Volume) * volume_count + kChecksumBytes);
+  out.reserve(kMapHeaderBytes + kCellRecordBytes * cells.size() + sizeof(Volume) * volume_count +
+              kChecksumBytes);
   Writer writer(out);
   writer.bytes(kMagic, sizeof(kMagic));
   writer.u32(kMapFormatVersion);
@@ -186,13 +186,14 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     const CellIndex cell{reader.i32(), reader.i32()};
     const std::uint64_t num_positive = reader.u32();
     const std::uint64_t num_negative = reader.u32();
-    const std::string where = "cell (" + std::to_string(cell.x) + ", " + std::to_string(cell.y) + ")";
+    const std::string where =
+        "cell (" + std::to_string(cell.x) + ", " + std::to_string(cell.y) + ")";
     if (num_positive + num_negative == 0) fail(where + " holds no volume");
     if (volumes_read + num_positive + num_negative > volume_count) {
       fail(where + " holds more volumes than the header counts");
     }
-    const std::uint64_t key =
-        (std::uint64_t{static_cast<std::uint32_t>(cell.x)} << 32) | static_cast<std::uint32_t>(cell.y);
+    const std::uint64_t key = (std::uint64_t{static_cast<std::uint32_t>(cell.x)} << 32) |
+                              static_cast<std::uint32_t>(cell.y);
     if (!seen.insert(key).second) fail(where + " appears twice");
     CellVolumes volumes;
     volumes.positive.resize(num_positive);

@@ -41,8 +41,9 @@ mvog::Scan scanToReadings(const sensor_msgs::LaserScan& scan,
   }
   if (!std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
       (scan.ranges.size() > 1 && scan.angle_increment == 0.0f)) {
-    throw InvalidMessage("LaserScan angle_min and angle_increment must be finite, and the "
-                         "increment non-zero");
+    throw InvalidMessage(
+        "LaserScan angle_min and angle_increment must be finite, and the "
+        "increment non-zero");
   }
   if (!std::isfinite(scan.range_min) || !std::isfinite(scan.range_max) || scan.range_min < 0.0f ||
       scan.range_max <= scan.range_min) {

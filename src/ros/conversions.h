@@ -4,9 +4,9 @@
 #include <stdexcept>
 #include <string>
 
-#include <Eigen/Geometry>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <Eigen/Geometry>
 
 #include "mvog/map.h"
 

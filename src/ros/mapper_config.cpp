@@ -127,12 +127,12 @@ void MapperConfig::validate() const {
   require(std::isfinite(voxel_filter_size) && voxel_filter_size >= 0.0, "voxel_filter_size",
           "must be a finite number >= 0 (0: off)");
   require(max_points_per_message >= 1, "max_points_per_message", "must be >= 1");
-  require(std::isfinite(decay_factor) && decay_factor > 0.0 && decay_factor <= 1.0,
-          "decay_factor", "must be in (0, 1]");
+  require(std::isfinite(decay_factor) && decay_factor > 0.0 && decay_factor <= 1.0, "decay_factor",
+          "must be in (0, 1]");
   requireDuration(decay_period, "decay_period", "off");
-  require(std::isfinite(occupancy_threshold) && occupancy_threshold >= 0.0 &&
-              occupancy_threshold < 1.0,
-          "occupancy_threshold", "must be in [0, 1)");
+  require(
+      std::isfinite(occupancy_threshold) && occupancy_threshold >= 0.0 && occupancy_threshold < 1.0,
+      "occupancy_threshold", "must be in [0, 1)");
   for (double height : cross_section_heights) {
     require(std::isfinite(height) && std::fabs(height) <= map.max_coordinate,
             "cross_section_heights", "every height must be finite and within max_coordinate");

@@ -14,10 +14,10 @@ namespace mvog_ros {
 /// and validated at start: an invalid value refuses to start, naming the parameter.
 struct MapperConfig {
   // Map and insertion (the core's own configs).
-  mvog::MapConfig map;               // ~resolution, ~max_coordinate
-  mvog::InsertionConfig insertion;   // ~min_range, ~max_range, ~insert_out_of_range,
-                                     // ~model_negative_space, ~clear_conflicting_free_space,
-                                     // ~insertion_threads
+  mvog::MapConfig map;              // ~resolution, ~max_coordinate
+  mvog::InsertionConfig insertion;  // ~min_range, ~max_range, ~insert_out_of_range,
+                                    // ~model_negative_space, ~clear_conflicting_free_space,
+                                    // ~insertion_threads
   std::string frame_id = "map";
 
   // Inputs.
@@ -38,14 +38,14 @@ struct MapperConfig {
   std::vector<double> cross_section_heights;
   double projection_min_z = -std::numeric_limits<double>::infinity();
   double projection_max_z = std::numeric_limits<double>::infinity();
-  double publish_period = 1.0;       // s, markers and grids (only what changed)
-  double binary_map_period = 5.0;    // s, the whole map on ~map (0: off)
-  double statistics_period = 1.0;    // s
+  double publish_period = 1.0;     // s, markers and grids (only what changed)
+  double binary_map_period = 5.0;  // s, the whole map on ~map (0: off)
+  double statistics_period = 1.0;  // s
 
   // Files.
-  std::string map_directory;   // save/load root; default $ROS_HOME/mvog_maps
-  std::string map_file;        // loaded at start if set (relative to map_directory)
-  double autosave_period = 0.0;          // s (0: off)
+  std::string map_directory;     // save/load root; default $ROS_HOME/mvog_maps
+  std::string map_file;          // loaded at start if set (relative to map_directory)
+  double autosave_period = 0.0;  // s (0: off)
   std::string autosave_file = "autosave.mvog";
 
   // Service limits.

@@ -24,10 +24,14 @@ std_msgs::ColorRGBA heightColour(double z, double top) {
   const double h = std::clamp(z / top, 0.0, 0.999) * 4.0;  // 0..4
   const auto f = static_cast<float>(h - std::floor(h));
   switch (static_cast<int>(h)) {
-    case 0: return colour(0, f, 1, 1);
-    case 1: return colour(0, 1, 1 - f, 1);
-    case 2: return colour(f, 1, 0, 1);
-    default: return colour(1, 1 - f, 0, 1);
+    case 0:
+      return colour(0, f, 1, 1);
+    case 1:
+      return colour(0, 1, 1 - f, 1);
+    case 2:
+      return colour(f, 1, 0, 1);
+    default:
+      return colour(1, 1 - f, 0, 1);
   }
 }
 
@@ -68,8 +72,8 @@ void appendBox(visualization_msgs::Marker& marker, const Eigen::Vector3d& min,
 /// A finished tile marker: ADD with its triangles, or DELETE if it has none.
 void appendTileMarker(visualization_msgs::Marker&& marker,
                       visualization_msgs::MarkerArray& markers) {
-  marker.action = marker.points.empty() ? visualization_msgs::Marker::DELETE
-                                        : visualization_msgs::Marker::ADD;
+  marker.action =
+      marker.points.empty() ? visualization_msgs::Marker::DELETE : visualization_msgs::Marker::ADD;
   markers.markers.push_back(std::move(marker));
 }
 
@@ -89,13 +93,13 @@ void appendVolumeMarkers(const mvog::Map& map, const mvog::TileIndex& tile,
   positive.color = colour(0.9f, 0.1f, 0.1f, 0.9f);
   negative.color = colour(0.1f, 0.3f, 0.9f, 0.25f);
   const double r = map.resolution();
-  map.forEachVolumeIn(mvog::Map::tileCells(tile), [&](const mvog::CellIndex& cell,
-                                                      mvog::VolumeSign sign,
-                                                      const mvog::Volume& volume) {
-    appendBox(sign == mvog::VolumeSign::kPositive ? positive : negative,
-              {cell.x * r, cell.y * r, volume.bottom * r},
-              {(cell.x + 1) * r, (cell.y + 1) * r, volume.top * r}, nullptr);
-  });
+  map.forEachVolumeIn(
+      mvog::Map::tileCells(tile),
+      [&](const mvog::CellIndex& cell, mvog::VolumeSign sign, const mvog::Volume& volume) {
+        appendBox(sign == mvog::VolumeSign::kPositive ? positive : negative,
+                  {cell.x * r, cell.y * r, volume.bottom * r},
+                  {(cell.x + 1) * r, (cell.y + 1) * r, volume.top * r}, nullptr);
+      });
   appendTileMarker(std::move(positive), markers);
   appendTileMarker(std::move(negative), markers);
 }
@@ -136,9 +140,12 @@ std::int8_t gridValue(float probability) {
 
 std::int8_t gridValue(mvog::OccupancyState state) {
   switch (state) {
-    case mvog::OccupancyState::kOccupied: return 100;
-    case mvog::OccupancyState::kFree: return 0;
-    case mvog::OccupancyState::kUnknown: break;
+    case mvog::OccupancyState::kOccupied:
+      return 100;
+    case mvog::OccupancyState::kFree:
+      return 0;
+    case mvog::OccupancyState::kUnknown:
+      break;
   }
   return -1;
 }
@@ -202,12 +209,12 @@ mvog::CellRange IncrementalGrid::update(const mvog::Map& map,
   for (const mvog::TileIndex& tile : changed) {
     const mvog::CellRange cells = mvog::Map::tileCells(tile);
     write(cells, compute_(map, cells));
-    touched = touched.empty()
-                  ? cells
-                  : mvog::CellRange{{std::min(touched.min.x, cells.min.x),
-                                     std::min(touched.min.y, cells.min.y)},
-                                    {std::max(touched.max.x, cells.max.x),
-                                     std::max(touched.max.y, cells.max.y)}};
+    touched =
+        touched.empty()
+            ? cells
+            : mvog::CellRange{
+                  {std::min(touched.min.x, cells.min.x), std::min(touched.min.y, cells.min.y)},
+                  {std::max(touched.max.x, cells.max.x), std::max(touched.max.y, cells.max.y)}};
   }
   return touched;
 }

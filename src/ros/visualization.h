@@ -53,8 +53,8 @@ class GridTooLarge : public std::length_error {
 class IncrementalGrid {
  public:
   /// compute(map, cells) evaluates the layer over a range of cells.
-  using Compute = std::function<nav_msgs::OccupancyGrid::_data_type(const mvog::Map&,
-                                                                   const mvog::CellRange&)>;
+  using Compute =
+      std::function<nav_msgs::OccupancyGrid::_data_type(const mvog::Map&, const mvog::CellRange&)>;
   /// A grid of at most max_cells cells.
   IncrementalGrid(double z, std::int64_t max_cells, Compute compute)
       : z_(z), max_cells_(max_cells), compute_(std::move(compute)) {}

@@ -43,13 +43,14 @@ void writeMapServerPair(const mvog::Grid2D<T>& grid, const std::string& prefix, 
   std::ostringstream pgm;
   pgm << "P5\n" << grid.width() << " " << grid.height() << "\n255\n";
   for (std::size_t row = grid.height(); row-- > 0;) {
-    for (std::size_t x = 0; x < grid.width(); ++x) pgm.put(static_cast<char>(grey(grid.at(x, row))));
+    for (std::size_t x = 0; x < grid.width(); ++x)
+      pgm.put(static_cast<char>(grey(grid.at(x, row))));
   }
   writeAtomically(prefix + ".pgm", pgm.str());
   const std::string image = prefix.substr(prefix.find_last_of('/') + 1) + ".pgm";
   std::ostringstream yaml;
-  yaml << "image: " << image << "\nmode: trinary\nresolution: " << grid.resolution
-       << "\norigin: [" << grid.originX() << ", " << grid.originY()
+  yaml << "image: " << image << "\nmode: trinary\nresolution: " << grid.resolution << "\norigin: ["
+       << grid.originX() << ", " << grid.originY()
        << ", 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
   writeAtomically(prefix + ".yaml", yaml.str());
   std::printf("wrote %s.pgm and %s.yaml (%zu x %zu cells)\n", prefix.c_str(), prefix.c_str(),
@@ -117,10 +118,14 @@ std::array<float, 3> heightColour(double t) {  // t in [0, 1]: blue, cyan, green
   const double h = std::clamp(t, 0.0, 1.0) * 4.0;
   const auto f = static_cast<float>(h - std::floor(h));
   switch (std::min(3, static_cast<int>(h))) {
-    case 0: return {0, f, 1};
-    case 1: return {0, 1, 1 - f};
-    case 2: return {f, 1, 0};
-    default: return {1, 1 - f, 0};
+    case 0:
+      return {0, f, 1};
+    case 1:
+      return {0, 1, 1 - f};
+    case 2:
+      return {f, 1, 0};
+    default:
+      return {1, 1 - f, 0};
   }
 }
 
@@ -183,7 +188,8 @@ void renderOccupied(const mvog::Map& map, double threshold, const std::string& p
         if (d >= depth_buffer[k]) continue;
         depth_buffer[k] = d;
         const float shade = (du == -radius || dv == -radius) ? 0.55f : 0.9f;  // cube edges
-        for (int ch = 0; ch < 3; ++ch) rgb[k * 3 + ch] = static_cast<std::uint8_t>(255 * c[ch] * shade);
+        for (int ch = 0; ch < 3; ++ch)
+          rgb[k * 3 + ch] = static_cast<std::uint8_t>(255 * c[ch] * shade);
       }
     }
   }
@@ -223,7 +229,8 @@ int main(int argc, char** argv) {
       } else if (option == "--cross-section" && k + 2 < argc) {
         const double z = number(argv[k + 1]);
         writeMapServerPair(map.crossSection(z, map.bounds()), argv[k + 2], [](float p) {
-          return std::isnan(p) ? kUnknownGrey : static_cast<std::uint8_t>(std::lround(255.0f * (1.0f - p)));
+          return std::isnan(p) ? kUnknownGrey
+                               : static_cast<std::uint8_t>(std::lround(255.0f * (1.0f - p)));
         });
         k += 2;
       } else if (option == "--projection" && k + 3 < argc) {

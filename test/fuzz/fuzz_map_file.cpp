@@ -41,7 +41,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
        {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(nan, 0.0, 0.0),
         Eigen::Vector3d(0.0, inf, 0.0), Eigen::Vector3d(1e300, -1e300, 1e300)}) {
     const mvog::PointOccupancy occupancy = map.occupancy(point);
-    if (occupancy.probability) check(*occupancy.probability >= 0.0f && *occupancy.probability <= 1.0f);
+    if (occupancy.probability)
+      check(*occupancy.probability >= 0.0f && *occupancy.probability <= 1.0f);
   }
   const mvog::CellRange bounds = map.bounds();
   if (!bounds.empty()) {
@@ -56,11 +57,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check(section.values.size() == static_cast<std::size_t>(window.width() * window.height()));
     map.projection(-inf, inf, 0.5, window);
     std::size_t visited = 0;
-    map.forEachVolumeIn(window, [&](const mvog::CellIndex& cell, mvog::VolumeSign,
-                                    const mvog::Volume&) {
-      check(window.contains(cell));
-      ++visited;
-    });
+    map.forEachVolumeIn(window,
+                        [&](const mvog::CellIndex& cell, mvog::VolumeSign, const mvog::Volume&) {
+                          check(window.contains(cell));
+                          ++visited;
+                        });
     check(visited <= usage.positive_volumes + usage.negative_volumes);
   }
   map.decay(0.5);

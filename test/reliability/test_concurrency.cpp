@@ -101,9 +101,8 @@ double readEverything(const mvog::Map& map, std::uint32_t seed) {
   sum += static_cast<double>(map.tilesModifiedSince(0).size());
   sum += static_cast<double>(mvog::serializeMap(map).size());
   std::size_t volumes = 0;
-  map.forEachVolume([&](const mvog::CellIndex&, mvog::VolumeSign, const mvog::Volume&) {
-    ++volumes;
-  });
+  map.forEachVolume(
+      [&](const mvog::CellIndex&, mvog::VolumeSign, const mvog::Volume&) { ++volumes; });
   sum += static_cast<double>(volumes);
   return sum;
 }

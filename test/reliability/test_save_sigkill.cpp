@@ -4,8 +4,8 @@
 // over; the parent kills it at a random moment, many times, and every time loads the file left.
 // Run by scripts/sanitizers.sh (AddressSanitizer + UBSan). No wall-clock time is asserted: the
 // length of one save only scales the random moments at which the child is killed.
-#include <gtest/gtest.h>
 #include <dirent.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -135,10 +135,11 @@ TEST(SaveUnderSigkill, EveryKillLeavesAMapThatLoads) {
     if (!temporaries.empty()) ++kills_leaving_a_temporary;
     for (const std::string& temporary : temporaries) ::unlink(temporary.c_str());
   }
-  std::printf("%d kills: %d left map A, %d map B; %d interrupted a save (left a temporary); "
-              "files of %zu and %zu bytes; one save takes ~%ld us\n",
-              kKills, loaded_a, loaded_b, kills_leaving_a_temporary, bytes_a.size(),
-              bytes_b.size(), static_cast<long>(save_time));
+  std::printf(
+      "%d kills: %d left map A, %d map B; %d interrupted a save (left a temporary); "
+      "files of %zu and %zu bytes; one save takes ~%ld us\n",
+      kKills, loaded_a, loaded_b, kills_leaving_a_temporary, bytes_a.size(), bytes_b.size(),
+      static_cast<long>(save_time));
   RecordProperty("kills_interrupting_a_save", kills_leaving_a_temporary);
   // The test killed some saves between creating the temporary and renaming it.
   EXPECT_GT(kills_leaving_a_temporary, 0);
