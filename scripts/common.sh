@@ -20,7 +20,7 @@ MVOG_PACKAGES=(
   libtf2-geometry-msgs-dev liblaser-geometry-dev libstd-srvs-dev libvisualization-msgs-dev
   libnav-msgs-dev libmap-msgs-dev libdiagnostic-msgs-dev rviz tf2-tools liboctomap-dev octomap-tools
   xvfb xauth x11-utils libgl1-mesa-dri imagemagick
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev clang-format-14
 )
 
 as_root() {

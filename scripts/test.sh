@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds (Release) and runs every test: the core alone with plain CMake
-# (no ROS), then the catkin package's gtests and rostests, then the sanitizer builds and fuzzing
-# (scripts/sanitizers.sh). Prints one summary line and exits
+# Installs what is missing, builds (Release) and runs every test: a formatting check, the core
+# alone with plain CMake (no ROS), then the catkin package's gtests and rostests, then the
+# sanitizer builds and fuzzing (scripts/sanitizers.sh). Prints one summary line and exits
 # non-zero on any failure. Tests that replay ../shared/data skip without it, but not when CI=true.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
@@ -11,6 +11,16 @@ passed=0
 failed=0
 skipped=0
 failures=()
+
+# 0. Every C++ file is formatted with the repository's .clang-format.
+unformatted=()
+while IFS= read -r -d '' file; do
+  clang-format-14 --dry-run --Werror "$REPO/$file" >/dev/null 2>&1 || unformatted+=("$file")
+done < <(cd "$REPO" && find include src test -name '*.cpp' -print0 -o -name '*.h' -print0)
+if [ ${#unformatted[@]} -eq 0 ]; then passed=$((passed + 1)); else
+  failed=$((failed + 1))
+  failures+=("clang-format (run clang-format-14 -i on): ${unformatted[*]}")
+fi
 
 # 1. The core with plain CMake: proves it builds and passes without catkin.
 core_build=$WORKSPACE/core_build
