@@ -42,7 +42,8 @@ std::vector<std::uint8_t> serializeMap(const Map& map);
 Map deserializeMap(const std::uint8_t* data, std::size_t size);
 
 /// Writes atomically: a temporary file in the same directory, fsync, then rename over `path`.
-/// Throws MapFileError on failure (and leaves any previous file at `path` untouched).
+/// Throws MapFileError on failure (and leaves any previous file at `path` untouched). Also removes
+/// the temporaries that earlier saves of `path`, killed before their rename, left beside it.
 void saveMap(const Map& map, const std::string& path);
 /// Throws MapFileError if the file cannot be read or is not a valid map.
 Map loadMap(const std::string& path);

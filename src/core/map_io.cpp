@@ -1,12 +1,14 @@
 #include "mvog/map_io.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <unordered_set>
 
 namespace mvog {
@@ -212,11 +214,62 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   return map;
 }
 
+namespace {
+
+constexpr char kTemporarySuffix[] = ".tmp.XXXXXX";  // mkstemp's template
+
+bool sameFile(int fd, const std::string& path) {
+  struct stat by_fd {};
+  struct stat by_path {};
+  return ::fstat(fd, &by_fd) == 0 && ::lstat(path.c_str(), &by_path) == 0 &&
+         by_fd.st_dev == by_path.st_dev && by_fd.st_ino == by_path.st_ino;
+}
+
+/// A temporary of saveMap(`path`), created and locked (flock) for the whole save: the lock goes
+/// with the process, so a temporary nobody holds locked is the leftover of a killed save.
+int createLockedTemporary(const std::string& path, std::string& temporary) {
+  for (;;) {
+    temporary = path + kTemporarySuffix;
+    const int fd = mkstemp(temporary.data());
+    if (fd < 0) throw MapFileError(systemError("cannot create a temporary file beside", path));
+    // Between mkstemp and flock, another save's clean-up may take it for a leftover and remove
+    // it: then start again with a new one.
+    if (::flock(fd, LOCK_EX) == 0 && sameFile(fd, temporary)) return fd;
+    ::close(fd);
+  }
+}
+
+/// Removes the temporaries that saves of `path` killed before their rename left (a robot's
+/// autosave killed again and again would otherwise fill its disk). Best effort: a temporary that
+/// cannot be inspected stays.
+void removeLeftoverTemporaries(const std::string& path) {
+  const std::filesystem::path target(path);
+  const std::string prefix = target.filename().string() + ".tmp.";
+  const std::size_t name_length = target.filename().string().size() + sizeof(kTemporarySuffix) - 1;
+  std::error_code error;
+  const std::filesystem::path directory =
+      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  for (std::filesystem::directory_iterator it(directory, error), end; !error && it != end;
+       it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() != name_length || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string candidate = it->path().string();
+    const int fd = ::open(candidate.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0) continue;
+    if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && sameFile(fd, candidate)) {
+      ::unlink(candidate.c_str());
+    }
+    ::close(fd);
+  }
+}
+
+}  // namespace
+
 void saveMap(const Map& map, const std::string& path) {
   const std::vector<std::uint8_t> bytes = serializeMap(map);
-  std::string temporary = path + ".tmp.XXXXXX";
-  const int fd = mkstemp(temporary.data());
-  if (fd < 0) throw MapFileError(systemError("cannot create a temporary file beside", path));
+  removeLeftoverTemporaries(path);
+  std::string temporary;
+  const int fd = createLockedTemporary(path, temporary);
   auto abandon = [&](const std::string& what) {
     const std::string message = systemError(what, temporary);
     ::close(fd);
@@ -232,16 +285,14 @@ void saveMap(const Map& map, const std::string& path) {
   }
   if (::fchmod(fd, 0644) != 0) abandon("cannot set the permissions of");
   if (::fsync(fd) != 0) abandon("cannot flush");
-  if (::close(fd) != 0) {
-    const std::string message = systemError("cannot close", temporary);
-    ::unlink(temporary.c_str());
-    throw MapFileError(message);
-  }
+  // Renamed while still open and locked, so that no clean-up takes it for a leftover.
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
     const std::string message = systemError("cannot rename the temporary file to", path);
+    ::close(fd);
     ::unlink(temporary.c_str());
     throw MapFileError(message);
   }
+  ::close(fd);  // the data is already on disk (fsync): nothing left for close to report
   // Make the rename itself durable.
   const std::size_t slash = path.find_last_of('/');
   const std::string directory = slash == std::string::npos ? "." : path.substr(0, slash + 1);

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <dirent.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -281,6 +283,36 @@ TEST(MapIo, FailedSaveThrowsAndLeavesNoTemporaryFile) {
   EXPECT_EQ(dir.entries(), (std::set<std::string>{"blocked"}));
   EXPECT_EQ(readFile(inside), (Bytes{1, 2, 3}));
   ::unlink(inside.c_str());
+}
+
+TEST(MapIo, SaveRemovesTheTemporariesOfKilledSavesOnly) {
+  TempDir dir;
+  const std::string path = dir.path() + "/map.mvog";
+  const std::string outside = dir.path() + "/outside";
+  writeFile(outside, {7});
+  // Left by a save killed before its rename: nobody holds it locked.
+  writeFile(path + ".tmp.Ab3xZ9", {1, 2});
+  // A save of the same path running in another process: locked (flock) until it renames.
+  const std::string running = path + ".tmp.Run123";
+  writeFile(running, {3});
+  const int running_fd = ::open(running.c_str(), O_RDONLY);
+  ASSERT_GE(running_fd, 0);
+  ASSERT_EQ(::flock(running_fd, LOCK_EX), 0);
+  // Not temporaries of this path: another map's, a longer name, a link to a file elsewhere.
+  writeFile(dir.path() + "/other.mvog.tmp.Ab3xZ9", {4});
+  writeFile(path + ".tmp.Ab3xZ9x", {5});
+  ASSERT_EQ(::symlink(outside.c_str(), (path + ".tmp.Link00").c_str()), 0);
+
+  saveMap(smallMap(), path);
+  EXPECT_EQ(dir.entries(),
+            (std::set<std::string>{"map.mvog", "map.mvog.tmp.Run123", "map.mvog.tmp.Link00",
+                                   "map.mvog.tmp.Ab3xZ9x", "other.mvog.tmp.Ab3xZ9", "outside"}));
+  EXPECT_EQ(readFile(outside), (Bytes{7}));
+  EXPECT_TRUE(test::sameVolumes(allVolumes(loadMap(path)), allVolumes(smallMap())));
+  // Once that save's process is gone (its lock with it), the next save removes its temporary.
+  ::close(running_fd);
+  saveMap(smallMap(), path);
+  EXPECT_EQ(dir.entries().count("map.mvog.tmp.Run123"), 0u);
 }
 
 TEST(MapIo, LoadRefusesMissingDirectoriesAndBrokenFiles) {
