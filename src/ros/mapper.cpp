@@ -281,13 +281,13 @@ void Mapper::insertionLoop() {
     mvog::InsertionResult result;
     if (config_.insertion.clear_conflicting_free_space) {
       // Sec. V.B's conflicts are those within one scan: the scan goes in whole.
-      std::unique_lock<std::shared_mutex> lock(map_mutex_);
+      std::unique_lock<WriterPreferringMutex> lock(map_mutex_);
       result = map_.insertScan(pending.scan, config_.insertion);
     } else {
       // Piece by piece, the same map (mvog::splitScan), and queries and publications wait for
       // one piece at most instead of a whole cloud.
       for (const mvog::Scan& piece : mvog::splitScan(pending.scan, kReadingsPerLock)) {
-        std::unique_lock<std::shared_mutex> lock(map_mutex_);
+        std::unique_lock<WriterPreferringMutex> lock(map_mutex_);
         result += map_.insertScan(piece, config_.insertion);
       }
     }
@@ -310,7 +310,7 @@ void Mapper::insertionLoop() {
 
 void Mapper::publishChanges(const ros::TimerEvent&) {
   std::lock_guard<std::mutex> publish_lock(publish_mutex_);
-  std::shared_lock<std::shared_mutex> lock(map_mutex_);
+  std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
   if (map_.revision() == published_revision_) return;
   const std::vector<mvog::TileIndex> changed = map_.tilesModifiedSince(published_revision_);
   published_revision_ = map_.revision();
@@ -350,7 +350,7 @@ void Mapper::publishChanges(const ros::TimerEvent&) {
 
 void Mapper::sendAllMarkers(const ros::SingleSubscriberPublisher& subscriber, bool occupied_only) {
   std::lock_guard<std::mutex> publish_lock(publish_mutex_);
-  std::shared_lock<std::shared_mutex> lock(map_mutex_);
+  std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
   const ros::Time stamp = ros::Time::now();
   visualization_msgs::MarkerArray markers;
   markers.markers.push_back(deleteAllMarker(config_.frame_id, stamp));
@@ -367,7 +367,7 @@ void Mapper::sendAllMarkers(const ros::SingleSubscriberPublisher& subscriber, bo
 
 void Mapper::sendGrid(const ros::SingleSubscriberPublisher& subscriber, std::size_t layer) {
   std::lock_guard<std::mutex> publish_lock(publish_mutex_);
-  std::shared_lock<std::shared_mutex> lock(map_mutex_);
+  std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
   bool relaid_out = false;
   if (!updateGrid(layer, map_.tilesModifiedSince(published_revision_), relaid_out) ||
       grids_[layer].cells().empty()) {  // too large, or nothing mapped yet
@@ -405,14 +405,14 @@ mvog::MapBinary Mapper::binaryMapMessage() const {
 }
 
 void Mapper::sendBinaryMap(const ros::SingleSubscriberPublisher& subscriber) {
-  std::shared_lock<std::shared_mutex> lock(map_mutex_);
+  std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
   subscriber.publish(binaryMapMessage());
 }
 
 void Mapper::publishBinaryMap(const ros::TimerEvent&) {
   if (binary_map_publisher_.getNumSubscribers() == 0) return;
   std::lock_guard<std::mutex> publish_lock(publish_mutex_);
-  std::shared_lock<std::shared_mutex> lock(map_mutex_);
+  std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
   if (map_.revision() == binary_revision_) return;
   binary_revision_ = map_.revision();
   binary_map_publisher_.publish(binaryMapMessage());
@@ -421,7 +421,7 @@ void Mapper::publishBinaryMap(const ros::TimerEvent&) {
 void Mapper::publishStatistics(const ros::TimerEvent&) {
   mvog::MapStatistics statistics;
   {
-    std::shared_lock<std::shared_mutex> lock(map_mutex_);
+    std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
     const mvog::MemoryUsage memory = map_.memoryUsage();
     statistics.resolution = map_.resolution();
     statistics.cells_with_volumes = memory.cells_with_volumes;
@@ -452,13 +452,13 @@ void Mapper::publishStatistics(const ros::TimerEvent&) {
 }
 
 void Mapper::decay(const ros::TimerEvent&) {
-  std::unique_lock<std::shared_mutex> lock(map_mutex_);
+  std::unique_lock<WriterPreferringMutex> lock(map_mutex_);
   map_.decay(config_.decay_factor);
 }
 
 void Mapper::autosave(const ros::TimerEvent&) {
   try {
-    std::shared_lock<std::shared_mutex> lock(map_mutex_);
+    std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
     if (map_.revision() == saved_revision_) return;
     mvog::saveMap(map_, resolveMapPath(config_.map_directory, config_.autosave_file, true));
     saved_revision_ = map_.revision();
@@ -513,7 +513,7 @@ bool Mapper::getOccupancy(mvog::GetOccupancy::Request& request,
   }
   response.probability.resize(request.points.size());
   response.state.resize(request.points.size());
-  std::shared_lock<std::shared_mutex> lock(map_mutex_);
+  std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
   for (std::size_t k = 0; k < request.points.size(); ++k) {
     const geometry_msgs::Point& p = request.points[k];
     const mvog::PointOccupancy occupancy =
@@ -531,7 +531,7 @@ bool Mapper::getCrossSection(mvog::GetCrossSection::Request& request,
     response.message = "height must be finite";
     return true;
   }
-  std::shared_lock<std::shared_mutex> lock(map_mutex_);
+  std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
   mvog::CellRange cells = map_.bounds();
   if (request.use_bounds) {
     if (!std::isfinite(request.min_x) || !std::isfinite(request.min_y) ||
@@ -565,7 +565,7 @@ bool Mapper::getCrossSection(mvog::GetCrossSection::Request& request,
 bool Mapper::saveMap(mvog::MapFile::Request& request, mvog::MapFile::Response& response) {
   try {
     const std::string path = resolveMapPath(config_.map_directory, request.path, true);
-    std::shared_lock<std::shared_mutex> lock(map_mutex_);
+    std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
     mvog::saveMap(map_, path);
     response.message = "saved " + path;
     response.success = true;
@@ -591,7 +591,7 @@ bool Mapper::loadMap(mvog::MapFile::Request& request, mvog::MapFile::Response& r
 bool Mapper::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   mvog::MapConfig config;
   {
-    std::shared_lock<std::shared_mutex> lock(map_mutex_);
+    std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
     config = map_.config();
   }
   replaceMap(mvog::Map(config));
@@ -603,7 +603,7 @@ bool Mapper::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res
 
 void Mapper::replaceMap(mvog::Map&& map) {
   std::lock_guard<std::mutex> publish_lock(publish_mutex_);
-  std::unique_lock<std::shared_mutex> lock(map_mutex_);
+  std::unique_lock<WriterPreferringMutex> lock(map_mutex_);
   map_ = std::move(map);
   saved_revision_ = 0;  // revisions of the new map say nothing about the autosaved file
   restartPublication();

@@ -27,6 +27,7 @@
 #include "mvog/MapFile.h"
 #include "mvog/map.h"
 #include "visualization.h"
+#include "writer_preferring_mutex.h"
 
 namespace mvog_ros {
 
@@ -119,7 +120,7 @@ class Mapper {
   ros::NodeHandle private_nh_;
   const MapperConfig config_;
 
-  mutable std::shared_mutex map_mutex_;
+  mutable WriterPreferringMutex map_mutex_;
   mvog::Map map_;
 
   tf2_ros::Buffer tf_buffer_;
