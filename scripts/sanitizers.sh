@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Sanitizer builds and fuzzing (see RELIABILITY.md), with plain CMake (test/sanitizers), beside
-# the catkin workspace in $WORKSPACE/sanitizers:
+# Sanitizer builds and fuzzing (see RELIABILITY.md) in $WORKSPACE/sanitizers: plain CMake builds
+# (test/sanitizers) and an instrumented catkin workspace:
 #   address  g++, AddressSanitizer + UndefinedBehaviorSanitizer (no recovery): the core gtests,
 #            the ROS conversion gtests, the concurrency and SIGKILL-during-save tests, and the
 #            fuzz corpora and regressions replayed through the fuzz targets' entry points;
+#   catkin   g++, ASan + UBSan: the catkin package's ROS gtests and the rostests of mvog_node
+#            (bad input, time jumps, SIGKILL during saves, overload, the whole ROS interface);
 #   thread   g++, ThreadSanitizer: the concurrency tests;
 #   fuzz     clang++-14, libFuzzer + ASan + UBSan: each target for MVOG_FUZZ_SECONDS (25) seconds,
 #            seeded with test/fuzz/corpus/<target> and test/fuzz/regressions/<target>. A crash is
@@ -67,6 +69,48 @@ if build address g++ test_mvog_core test_conversions test_concurrency test_save_
   done
 else
   for name in "${asan_checks[@]}"; do fail "$name: the address build failed"; done
+fi
+
+# The catkin package under ASan + UBSan: its ROS gtests and the rostests of mvog_node (not those
+# of the nodelet: an instrumented plugin cannot be loaded into Debian's uninstrumented nodelet
+# manager; not the replays of ../shared/data: minutes each). A sanitizer report by any process
+# fails the check and is appended to its log.
+asan_workspace=$BUILD_ROOT/catkin
+asan_reports=$LOG_DIR/asan-ros
+sanitize="-fsanitize=address,undefined -fno-sanitize-recover=all"
+# in_asan_workspace COMMAND...: runs COMMAND with the instrumented workspace sourced.
+in_asan_workspace() {
+  rm -rf "$asan_reports"
+  mkdir -p "$asan_reports"
+  if (
+    set +u
+    # shellcheck disable=SC1091
+    source "$asan_workspace/devel/setup.bash"
+    set -u
+    export ASAN_OPTIONS=detect_leaks=1:log_path=$asan_reports/asan
+    export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:log_path=$asan_reports/ubsan
+    export ROS_TEST_RESULTS_DIR=$asan_workspace/test_results
+    "$@"
+  ) && [ -z "$(ls -A "$asan_reports")" ]; then
+    return 0
+  fi
+  cat "$asan_reports"/* 2>/dev/null || true
+  return 1
+}
+asan_ros_tests=(mapper_node decay bad_input time_jump kill_during_save overload)
+mkdir -p "$asan_workspace/src"
+ln -sfn "$REPO" "$asan_workspace/src/mvog"
+if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS="$sanitize -fno-omit-frame-pointer" \
+  -DCMAKE_EXE_LINKER_FLAGS="$sanitize" -DCMAKE_SHARED_LINKER_FLAGS="$sanitize" \
+  -DCATKIN_ENABLE_TESTING=ON -j2 mvog_node test_mvog_ros test_mapper_node mvog_generate_messages); then
+  check asan-ros-gtests in_asan_workspace "$asan_workspace/devel/lib/mvog/test_mvog_ros"
+  for test in "${asan_ros_tests[@]}"; do
+    check "asan-rostest-$test" in_asan_workspace rostest mvog "$test.test"
+  done
+else
+  fail "asan-ros-gtests: the instrumented catkin build failed"
+  for test in "${asan_ros_tests[@]}"; do fail "asan-rostest-$test: the instrumented catkin build failed"; done
 fi
 
 if build thread g++ test_concurrency; then
