@@ -117,8 +117,8 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
     timers_.push_back(nh_.createTimer(ros::Duration(config_.decay_period), &Mapper::decay, this));
   }
   if (config_.autosave_period > 0.0) {
-    timers_.push_back(
-        nh_.createTimer(ros::Duration(config_.autosave_period), &Mapper::autosave, this));
+    timers_.push_back(nh_.createTimer(ros::Duration(config_.autosave_period),
+                                      [this](const ros::TimerEvent&) { autosave(); }));
   }
   last_statistics_time_ = ros::WallTime::now();
   insertion_thread_ = std::thread(&Mapper::insertionLoop, this);
@@ -146,6 +146,8 @@ Mapper::~Mapper() {
   }
   queue_changed_.notify_all();
   insertion_thread_.join();
+  // A clean shutdown loses nothing mapped since the last autosave.
+  if (config_.autosave_period > 0.0) autosave();
 }
 
 template <class Message>
@@ -456,7 +458,7 @@ void Mapper::decay(const ros::TimerEvent&) {
   map_.decay(config_.decay_factor);
 }
 
-void Mapper::autosave(const ros::TimerEvent&) {
+void Mapper::autosave() {
   try {
     std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
     if (map_.revision() == saved_revision_) return;

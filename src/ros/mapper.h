@@ -92,7 +92,8 @@ class Mapper {
   void publishBinaryMap(const ros::TimerEvent&);
   void publishStatistics(const ros::TimerEvent&);
   void decay(const ros::TimerEvent&);
-  void autosave(const ros::TimerEvent&);
+  /// Saves ~autosave_file if the map changed since the last autosave (a warning if it fails).
+  void autosave();
   void sendAllMarkers(const ros::SingleSubscriberPublisher& subscriber, bool occupied_only);
   void sendGrid(const ros::SingleSubscriberPublisher& subscriber, std::size_t layer);
   /// Brings grid `layer` up to date (IncrementalGrid::update): the rectangle that changed, or

@@ -63,10 +63,13 @@ class CloudFeeder(threading.Thread):
 
 
 class KillDuringSave(unittest.TestCase):
-    def test_every_kill_leaves_a_map_the_next_server_resumes(self):
+    @classmethod
+    def setUpClass(cls):
         rospy.init_node("test_kill_during_save", disable_signals=True)
-        broadcaster = rel.tf2_ros.StaticTransformBroadcaster()
-        rel.publish_static_frames(broadcaster)
+        cls.broadcaster = rel.tf2_ros.StaticTransformBroadcaster()
+        rel.publish_static_frames(cls.broadcaster)
+
+    def test_every_kill_leaves_a_map_the_next_server_resumes(self):
         directory = tempfile.mkdtemp(prefix="mvog_reliability_kill_")
         path = os.path.join(directory, AUTOSAVE)
         kills_during_saves = 0
@@ -127,6 +130,26 @@ class KillDuringSave(unittest.TestCase):
             # kill's can be left (if the last server had no reason to save).
             self.assertLessEqual(len(leftovers), 1, "temporaries of killed saves pile up")
             self.assertGreater(kills_during_saves, 0, "no kill landed during a save")
+        finally:
+            shutil.rmtree(directory, ignore_errors=True)
+
+    def test_a_clean_shutdown_saves_what_was_mapped_since_the_last_autosave(self):
+        directory = tempfile.mkdtemp(prefix="mvog_reliability_shutdown_")
+        try:
+            # An autosave period far longer than the test: only the shutdown can save.
+            server = rel.Server("mapper_shutdown", {"autosave_period": 3600.0,
+                                                    "autosave_file": AUTOSAVE},
+                                directory=directory).wait_ready()
+            try:
+                server.scans.publish(rel.scan([2.0] * 32))
+                statistics = server.wait_counter("messages_inserted", 1)
+                self.assertFalse(os.path.exists(os.path.join(directory, AUTOSAVE)))
+            finally:
+                server.stop()  # SIGINT
+            self.assertEqual(server.process.returncode, 0)
+            self.assertEqual(header_counts(os.path.join(directory, AUTOSAVE)),
+                             (statistics.cells_with_volumes,
+                              statistics.positive_volumes + statistics.negative_volumes))
         finally:
             shutil.rmtree(directory, ignore_errors=True)
 
