@@ -59,10 +59,14 @@ def transform(parent, child, x=0.0, y=0.0, z=0.0, yaw=0.0, stamp=None):
     return t
 
 
-def publish_static_frames(broadcaster):
-    """map -> laser (0.5 m up) and map -> camera (1 m up), in one latched message."""
+def init_test_node(name):
+    """The test's ROS node, publishing map -> laser (0.5 m up) and map -> camera (1 m up) as
+    static transforms; returns the broadcaster, to be kept for as long as they are needed."""
+    rospy.init_node(name, disable_signals=True)
+    broadcaster = tf2_ros.StaticTransformBroadcaster()
     broadcaster.sendTransform([transform("map", "laser", z=LASER_HEIGHT),
                                transform("map", "camera", z=CAMERA_HEIGHT)])
+    return broadcaster
 
 
 def scan(ranges, frame="laser", stamp=None, angle_min=0.0, angle_increment=None,
@@ -242,5 +246,5 @@ def rss_kb(pid):
     return 0
 
 
-__all__ = ["Server", "wait_for", "wait_for_or_not", "transform", "publish_static_frames", "scan", "cloud",
-           "fnv1a64", "rss_kb", "tf2_ros", "FLOAT32", "FLOAT64", "INT32", "XYZ32", "TIMEOUT"]
+__all__ = ["Server", "wait_for", "wait_for_or_not", "transform", "init_test_node", "scan", "cloud",
+           "fnv1a64", "rss_kb", "FLOAT32", "FLOAT64", "INT32", "XYZ32", "TIMEOUT"]

@@ -14,7 +14,6 @@ import shutil
 import struct
 import sys
 import tempfile
-import time
 import unittest
 
 import rospy
@@ -39,9 +38,7 @@ def record(what, outcome):
 class BadInput(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        rospy.init_node("test_bad_input", disable_signals=True)
-        cls.broadcaster = rel.tf2_ros.StaticTransformBroadcaster()
-        rel.publish_static_frames(cls.broadcaster)
+        cls.broadcaster = rel.init_test_node("test_bad_input")
         cls.server = rel.Server("mapper_bad_input", {
             "max_points_per_message": MAX_POINTS, "max_query_points": MAX_QUERY_POINTS,
             "sensor_queue_size": SENSOR_QUEUE, "insertion_queue_size": 50}).wait_ready()

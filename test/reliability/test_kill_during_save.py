@@ -19,7 +19,6 @@ import time
 import unittest
 import shutil
 
-import rospy
 import rostest
 
 import mvog_reliability as rel
@@ -65,9 +64,7 @@ class CloudFeeder(threading.Thread):
 class KillDuringSave(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        rospy.init_node("test_kill_during_save", disable_signals=True)
-        cls.broadcaster = rel.tf2_ros.StaticTransformBroadcaster()
-        rel.publish_static_frames(cls.broadcaster)
+        cls.broadcaster = rel.init_test_node("test_kill_during_save")
 
     def test_every_kill_leaves_a_map_the_next_server_resumes(self):
         directory = tempfile.mkdtemp(prefix="mvog_reliability_kill_")

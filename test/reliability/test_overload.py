@@ -39,9 +39,7 @@ def wall_cloud(seed, behind=False):
 
 class Overload(unittest.TestCase):
     def test_a_faster_sensor_loses_whole_counted_messages_and_keeps_the_newest(self):
-        rospy.init_node("test_overload", disable_signals=True)
-        broadcaster = rel.tf2_ros.StaticTransformBroadcaster()
-        rel.publish_static_frames(broadcaster)
+        broadcaster = rel.init_test_node("test_overload")
         server = rel.Server("mapper_overload", {"resolution": 0.05, "insertion_queue_size": 2,
                                                 "max_range": 6.0}).wait_ready()
         clouds = [wall_cloud(k) for k in range(4)]

@@ -10,7 +10,6 @@ server's output); without that, the scans of the second pass would be placed wit
 pass's transforms of the same stamps. Checked: the second pass is mapped where it was taken, the
 first pass is still in the map, the server's timers (statistics) keep running, it stays alive.
 """
-import math
 import sys
 import threading
 import time
