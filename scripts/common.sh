@@ -82,5 +82,14 @@ start_private_master() {
   mkdir -p "$LOG_DIR"
   roscore -p "$port" >"$LOG_DIR/$1-roscore.log" 2>&1 &
   BACKGROUND_PIDS+=($!)
-  until rosparam list >/dev/null 2>&1; do sleep 0.5; done
+  local waited=0
+  until rosparam list >/dev/null 2>&1; do
+    if ! kill -0 "${BACKGROUND_PIDS[-1]}" 2>/dev/null || [ "$waited" -ge 120 ]; then
+      echo "the ROS master did not start (log: $LOG_DIR/$1-roscore.log):" >&2
+      tail -n 20 "$LOG_DIR/$1-roscore.log" >&2
+      exit 1
+    fi
+    sleep 0.5
+    waited=$((waited + 1))
+  done
 }

@@ -11,7 +11,8 @@ room at --query-rate Hz. The script starts its own mvog_node (the server's defau
 - readings inserted per second (the server's own counters over the run),
 - messages published, inserted, dropped by the server and counted (by queue), and lost before the
   server saw them (roscpp's subscriber queue of ~sensor_queue_size messages drops silently),
-- query latency p50 / p99 / max, as the client sees it (serialisation included),
+- query latency p50 / p99 / max, as the client sees it over a persistent connection
+  (serialisation of the request and the answer included),
 - the server's RSS and the map's bytes_held every --sample-period s.
 
 This is a benchmark, not a test: nothing is asserted about time. It fails (exit 1) only if the
@@ -26,11 +27,13 @@ import time
 
 import numpy as np
 import rospy
+from geometry_msgs.msg import Point
 from tf2_msgs.msg import TFMessage
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "test",
                                 "reliability"))
 import mvog_reliability as rel  # noqa: E402
+from mvog.srv import GetOccupancy  # noqa: E402
 
 ROOM_MIN = np.array([-10.0, -6.0, 0.0])
 ROOM_MAX = np.array([10.0, 6.0, 3.0])
@@ -108,24 +111,33 @@ class Sampler(threading.Thread):
 
 
 class Querier(threading.Thread):
+    """A planner's client: one persistent connection, the same random points of the room."""
+
     def __init__(self, server, points, rate):
         super().__init__(daemon=True)
         random = np.random.default_rng(7)
-        self.points = [tuple(p) for p in random.uniform(ROOM_MIN, ROOM_MAX, (points, 3))]
-        self.server, self.period = server, 1.0 / rate
+        self.points = [Point(*p) for p in random.uniform(ROOM_MIN, ROOM_MAX, (points, 3))]
+        self.service = rospy.ServiceProxy(server.ns + "/get_occupancy", GetOccupancy,
+                                          persistent=True)
+        self.period = 1.0 / rate
         self.latencies, self.failures, self.known = [], [], []
         self.done = threading.Event()
 
     def run(self):
         while not self.done.is_set():
             start = time.monotonic()
-            response = self.server.occupancy(self.points)
+            try:
+                response = self.service(frame_id="", points=self.points)
+            except (rospy.ServiceException, rospy.ROSException) as e:
+                self.failures.append(str(e))
+                response = None
             self.latencies.append(time.monotonic() - start)
-            if response.success:
+            if response is not None and response.success:
                 self.known.append(sum(1 for state in response.state if state != 0))
-            else:
+            elif response is not None:
                 self.failures.append(response.message)
             self.done.wait(max(0.0, self.period - (time.monotonic() - start)))
+        self.service.close()
 
 
 def percentile(values, fraction):
@@ -140,64 +152,70 @@ def main():
                                       "insertion_threads": args.insertion_threads,
                                       "statistics_period": 1.0, "publish_period": 1.0,
                                       "binary_map_period": 5.0}).wait_ready()
-    tf_publisher = rospy.Publisher("/tf", TFMessage, queue_size=100)
-    ray_sets = [RaySet(args.points, seed) for seed in range(4)]
-    template = rel.cloud([], width=args.points, frame=SENSOR_FRAME,
-                         data=bytes(12 * args.points))
     sampler = Sampler(server, args.sample_period)
     querier = Querier(server, args.query_points, args.query_rate)
-    before = server.stats()
-    sampler.start()
-    querier.start()
-    print("publishing %d-point clouds at %.0f Hz for %.0f s, querying %d points at %.0f Hz ..."
-          % (args.points, args.rate, args.duration, args.query_points, args.query_rate),
-          flush=True)
-    published, skipped, slot = 0, 0, 0
-    start = time.monotonic()
-    while slot < args.duration * args.rate:
-        now = time.monotonic()
-        due = start + slot / args.rate
-        if now < due:
-            time.sleep(due - now)
-        elif now - due >= 1.0 / args.rate:
-            # This machine could not make and send the previous cloud within its period: the
-            # slots missed are skipped (and reported), so that the run lasts --duration.
-            missed = int((now - due) * args.rate)
-            skipped += missed
-            slot += missed
-            continue
-        slot += 1
-        stamp = rospy.Time.now()
-        t = time.monotonic() - start
-        position, yaw = sensor_pose(t)
-        transform = rel.transform("map", SENSOR_FRAME, *position, yaw=yaw, stamp=stamp)
-        tf_publisher.publish(TFMessage([transform]))
-        template.header.stamp = stamp
-        template.data = ray_sets[published % len(ray_sets)].room_cloud(position, yaw)
-        server.clouds.publish(template)
-        published += 1
-        # A second pose between clouds, so that tf interpolates (the pose rate is twice the cloud
-        # rate).
-        half = stamp + rospy.Duration(0.5 / args.rate)
-        position, yaw = sensor_pose(t + 0.5 / args.rate)
-        tf_publisher.publish(TFMessage([rel.transform("map", SENSOR_FRAME, *position, yaw=yaw,
-                                                      stamp=half)]))
-    publishing_seconds = time.monotonic() - start
-    # The server drains what it queued; then its counters are final.
-    final = server.stats()
-    while True:
-        time.sleep(2.0)
-        now = server.stats()
-        if now.messages_inserted == final.messages_inserted:
-            break
-        final = now
-    querier.done.set()
-    querier.join()
-    sampler.done.set()
-    sampler.join()
-    alive = server.alive()
-    rss_end = rel.rss_kb(server.process.pid) / 1024.0 if alive else float("nan")
-    server.stop()
+    try:
+        tf_publisher = rospy.Publisher("/tf", TFMessage, queue_size=100)
+        ray_sets = [RaySet(args.points, seed) for seed in range(4)]
+        template = rel.cloud([], width=args.points, frame=SENSOR_FRAME,
+                             data=bytes(12 * args.points))
+        before = server.stats()
+        sampler.start()
+        querier.start()
+        print("publishing %d-point clouds at %.0f Hz for %.0f s, querying %d points at %.0f Hz"
+              " ..." % (args.points, args.rate, args.duration, args.query_points, args.query_rate),
+              flush=True)
+        published, skipped, slot = 0, 0, 0
+        start = time.monotonic()
+        while slot < args.duration * args.rate:
+            now = time.monotonic()
+            due = start + slot / args.rate
+            if now < due:
+                time.sleep(due - now)
+            elif now - due >= 1.0 / args.rate:
+                # This machine could not make and send the previous cloud within its period: the
+                # slots missed are skipped (and reported), so that the run lasts --duration.
+                missed = int((now - due) * args.rate)
+                skipped += missed
+                slot += missed
+                continue
+            slot += 1
+            stamp = rospy.Time.now()
+            t = time.monotonic() - start
+            position, yaw = sensor_pose(t)
+            transform = rel.transform("map", SENSOR_FRAME, *position, yaw=yaw, stamp=stamp)
+            tf_publisher.publish(TFMessage([transform]))
+            template.header.stamp = stamp
+            template.data = ray_sets[published % len(ray_sets)].room_cloud(position, yaw)
+            server.clouds.publish(template)
+            published += 1
+            # A second pose between clouds, so that tf interpolates (poses at twice the rate).
+            half = stamp + rospy.Duration(0.5 / args.rate)
+            position, yaw = sensor_pose(t + 0.5 / args.rate)
+            tf_publisher.publish(TFMessage([rel.transform("map", SENSOR_FRAME, *position, yaw=yaw,
+                                                          stamp=half)]))
+        publishing_seconds = time.monotonic() - start
+        # The server drains what it queued; then its counters are final.
+        final = server.stats()
+        while True:
+            time.sleep(2.0)
+            now = server.stats()
+            if now.messages_inserted == final.messages_inserted:
+                break
+            final = now
+        alive = server.alive()
+        rss_end = rel.rss_kb(server.process.pid) / 1024.0 if alive else float("nan")
+    except AssertionError as e:  # a wait for the server timed out
+        print("FAILED: %s (server log: %s)" % (e, server.log_path))
+        return 1
+    finally:
+        querier.done.set()
+        sampler.done.set()
+        if querier.is_alive():
+            querier.join()
+        if sampler.is_alive():
+            sampler.join()
+        server.stop()
 
     inserted = final.messages_inserted - before.messages_inserted
     dropped_queue = final.messages_dropped_queue - before.messages_dropped_queue
@@ -223,8 +241,9 @@ def main():
         "rss_end_mb": rss_end, "bytes_held_end_mb": final.bytes_held / 1e6,
         "memory": sampler.rows, "server_alive": alive,
     }
-    print("\nclouds: %d published in %.1f s (%d slots skipped: publisher too slow), %d inserted, %d dropped from the insertion "
-          "queue (counted), %d dropped waiting for tf, %d invalid, %d lost uncounted"
+    print("\nclouds: %d published in %.1f s (%d slots skipped: publisher too slow), %d inserted, "
+          "%d dropped from the insertion queue (counted), %d dropped waiting for tf, %d invalid, "
+          "%d lost uncounted"
           % (published, publishing_seconds, skipped, inserted, dropped_queue, dropped_tf,
              dropped_invalid, published - counted))
     print("readings inserted: %.0f per second of publishing, %.0f per second of insertion"

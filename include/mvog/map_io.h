@@ -41,10 +41,14 @@ std::vector<std::uint8_t> serializeMap(const Map& map);
 /// Throws MapFileError if `data` is not a complete, valid map (nothing is half-loaded).
 Map deserializeMap(const std::uint8_t* data, std::size_t size);
 
-/// Writes atomically: a temporary file in the same directory, fsync, then rename over `path`.
-/// Throws MapFileError on failure (and leaves any previous file at `path` untouched). Also removes
-/// the temporaries that earlier saves of `path`, killed before their rename, left beside it.
+/// Writes atomically: a temporary file in the same directory (`.NAME.saving-XXXXXX`), fsync,
+/// then rename over `path`. Throws MapFileError on failure (and leaves any previous file at `path`
+/// untouched). Also removes the temporaries that earlier saves of `path`, killed before their
+/// rename, left beside it (on a local file system with flock).
 void saveMap(const Map& map, const std::string& path);
+/// The same for bytes of serializeMap: a caller that shares the map with other threads can
+/// serialise under its lock and write after releasing it.
+void saveMapBytes(const std::vector<std::uint8_t>& bytes, const std::string& path);
 /// Throws MapFileError if the file cannot be read or is not a valid map.
 Map loadMap(const std::string& path);
 

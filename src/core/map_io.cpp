@@ -216,7 +216,13 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
 
 namespace {
 
-constexpr char kTemporarySuffix[] = ".tmp.XXXXXX";  // mkstemp's template
+// A save writes `.NAME.saving-XXXXXX` beside NAME (mkstemp's template): hidden, and a name no
+// map path of the server can take (src/ros/map_paths.cpp refuses hidden names).
+std::string temporaryPrefix(const std::filesystem::path& target) {
+  return "." + target.filename().string() + ".saving-";
+}
+constexpr std::size_t kTemporaryRandomChars = 6;
+constexpr int kTemporaryAttempts = 100;
 
 bool sameFile(int fd, const std::string& path) {
   struct stat by_fd {};
@@ -225,18 +231,24 @@ bool sameFile(int fd, const std::string& path) {
          by_fd.st_dev == by_path.st_dev && by_fd.st_ino == by_path.st_ino;
 }
 
-/// A temporary of saveMap(`path`), created and locked (flock) for the whole save: the lock goes
-/// with the process, so a temporary nobody holds locked is the leftover of a killed save.
+/// A temporary of a save to `path`, locked (flock) until the save ends: the lock goes with the
+/// process, so a temporary nobody holds locked is the leftover of a killed save. On a file system
+/// without flock the temporary stays unlocked, and no clean-up there can tell leftovers (it
+/// removes none). Assumes a local file system: over NFS, flock is emulated per process.
 int createLockedTemporary(const std::string& path, std::string& temporary) {
-  for (;;) {
-    temporary = path + kTemporarySuffix;
-    const int fd = mkstemp(temporary.data());
+  const std::filesystem::path target(path);
+  for (int attempt = 0; attempt < kTemporaryAttempts; ++attempt) {
+    temporary = (target.parent_path() / temporaryPrefix(target)).string() +
+                std::string(kTemporaryRandomChars, 'X');
+    const int fd = ::mkostemp(temporary.data(), O_CLOEXEC);
     if (fd < 0) throw MapFileError(systemError("cannot create a temporary file beside", path));
-    // Between mkstemp and flock, another save's clean-up may take it for a leftover and remove
-    // it: then start again with a new one.
-    if (::flock(fd, LOCK_EX) == 0 && sameFile(fd, temporary)) return fd;
+    if (::flock(fd, LOCK_EX) != 0) return fd;
+    if (sameFile(fd, temporary)) return fd;
+    // Between mkostemp and flock, another save's clean-up took it for a leftover and removed it.
     ::close(fd);
   }
+  throw MapFileError("cannot keep a temporary file beside '" + path + "': removed " +
+                     std::to_string(kTemporaryAttempts) + " times by other saves");
 }
 
 /// Removes the temporaries that saves of `path` killed before their rename left (a robot's
@@ -244,20 +256,25 @@ int createLockedTemporary(const std::string& path, std::string& temporary) {
 /// cannot be inspected stays.
 void removeLeftoverTemporaries(const std::string& path) {
   const std::filesystem::path target(path);
-  const std::string prefix = target.filename().string() + ".tmp.";
-  const std::size_t name_length = target.filename().string().size() + sizeof(kTemporarySuffix) - 1;
-  std::error_code error;
+  const std::string prefix = temporaryPrefix(target);
   const std::filesystem::path directory =
       target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  std::error_code error;
   for (std::filesystem::directory_iterator it(directory, error), end; !error && it != end;
        it.increment(error)) {
     const std::string name = it->path().filename().string();
-    if (name.size() != name_length || name.compare(0, prefix.size(), prefix) != 0) continue;
+    if (name.size() != prefix.size() + kTemporaryRandomChars ||
+        name.compare(0, prefix.size(), prefix) != 0) {
+      continue;
+    }
     const std::string candidate = it->path().string();
-    const int fd = ::open(candidate.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    // Not following links, not blocking on a FIFO; read-write, as flock over NFS requires.
+    const int fd = ::open(candidate.c_str(), O_RDWR | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) continue;
-    if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && sameFile(fd, candidate)) {
-      ::unlink(candidate.c_str());
+    struct stat status {};
+    if (::fstat(fd, &status) == 0 && S_ISREG(status.st_mode) &&
+        ::flock(fd, LOCK_EX | LOCK_NB) == 0 && sameFile(fd, candidate)) {
+      ::unlink(candidate.c_str());  // before close: the lock is held until it is gone
     }
     ::close(fd);
   }
@@ -265,32 +282,29 @@ void removeLeftoverTemporaries(const std::string& path) {
 
 }  // namespace
 
-void saveMap(const Map& map, const std::string& path) {
-  const std::vector<std::uint8_t> bytes = serializeMap(map);
+void saveMap(const Map& map, const std::string& path) { saveMapBytes(serializeMap(map), path); }
+
+void saveMapBytes(const std::vector<std::uint8_t>& bytes, const std::string& path) {
   removeLeftoverTemporaries(path);
   std::string temporary;
   const int fd = createLockedTemporary(path, temporary);
-  auto abandon = [&](const std::string& what) {
-    const std::string message = systemError(what, temporary);
-    ::close(fd);
+  auto abandon = [&](const std::string& message) {
     ::unlink(temporary.c_str());
+    ::close(fd);
     throw MapFileError(message);
   };
   std::size_t written = 0;
   while (written < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) abandon("cannot write");
+    if (n <= 0) abandon(systemError("cannot write", temporary));
     written += static_cast<std::size_t>(n);
   }
-  if (::fchmod(fd, 0644) != 0) abandon("cannot set the permissions of");
-  if (::fsync(fd) != 0) abandon("cannot flush");
+  if (::fchmod(fd, 0644) != 0) abandon(systemError("cannot set the permissions of", temporary));
+  if (::fsync(fd) != 0) abandon(systemError("cannot flush", temporary));
   // Renamed while still open and locked, so that no clean-up takes it for a leftover.
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    const std::string message = systemError("cannot rename the temporary file to", path);
-    ::close(fd);
-    ::unlink(temporary.c_str());
-    throw MapFileError(message);
+    abandon(systemError("cannot rename the temporary file to", path));
   }
   ::close(fd);  // the data is already on disk (fsync): nothing left for close to report
   // Make the rename itself durable.

@@ -23,6 +23,13 @@ bool isInside(const std::string& path, const std::string& root) {
          (root.back() == '/' || path[root.size()] == '/');
 }
 
+/// Whether the last component of `path` is a hidden name: reserved for the temporaries of saves
+/// (mvog::saveMap writes `.NAME.saving-XXXXXX` and removes those nobody holds).
+bool isHiddenName(const std::string& path) {
+  const std::string name = path.substr(path.find_last_of('/') + 1);
+  return name.size() > 1 && name.front() == '.' && name != "..";
+}
+
 }  // namespace
 
 std::string resolveMapPath(const std::string& directory, const std::string& requested,
@@ -64,6 +71,10 @@ std::string resolveMapPath(const std::string& directory, const std::string& requ
   }
   if (!isInside(resolved, root)) {
     throw PathRefused("'" + requested + "' resolves outside the map directory '" + root + "'");
+  }
+  if (isHiddenName(requested) || isHiddenName(resolved)) {
+    throw PathRefused("'" + requested +
+                      "' is a hidden name (reserved for the temporaries of saves)");
   }
   return resolved;
 }

@@ -14,7 +14,8 @@ class PathRefused : public std::runtime_error {
 /// Resolves `requested` (relative to `directory`, or absolute) for reading or writing a map and
 /// refuses anything that resolves outside `directory` once every symlink and ".." is followed:
 /// a service must not become a way to read or write arbitrary files. For writing, the file may
-/// not exist yet, but its parent directory must (inside `directory`). Returns the real path.
+/// not exist yet, but its parent directory must (inside `directory`). Hidden names (".x") are
+/// refused: the temporaries of saves have them. Returns the real path.
 std::string resolveMapPath(const std::string& directory, const std::string& requested,
                            bool for_writing);
 

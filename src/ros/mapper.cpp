@@ -17,7 +17,8 @@ namespace {
 
 constexpr double kWarningPeriod = 5.0;          // s between two warnings of one kind
 constexpr double kTransformRetryPeriod = 0.01;  // s between checks for awaited transforms
-// Readings inserted under one hold of the map's lock: ~50 ms at 5 cm, the longest a query waits.
+// Readings inserted under one hold of the map's lock: ~50 ms at 5 cm, the longest insertion
+// keeps a query waiting.
 constexpr std::size_t kReadingsPerLock = 16384;
 
 /// Creates ~map_directory if missing and returns the map a server starts with: ~map_file if set,
@@ -275,7 +276,7 @@ void Mapper::insertionLoop() {
     {
       std::unique_lock<std::mutex> lock(queue_mutex_);
       queue_changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
-      if (stopping_) return;
+      if (queue_.empty()) return;  // stopping, and what was queued is in the map
       pending = std::move(queue_.front());
       queue_.pop_front();
     }
@@ -407,17 +408,25 @@ mvog::MapBinary Mapper::binaryMapMessage() const {
 }
 
 void Mapper::sendBinaryMap(const ros::SingleSubscriberPublisher& subscriber) {
-  std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
-  subscriber.publish(binaryMapMessage());
+  mvog::MapBinary message;
+  {
+    std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
+    message = binaryMapMessage();
+  }
+  subscriber.publish(message);
 }
 
 void Mapper::publishBinaryMap(const ros::TimerEvent&) {
   if (binary_map_publisher_.getNumSubscribers() == 0) return;
   std::lock_guard<std::mutex> publish_lock(publish_mutex_);
-  std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
-  if (map_.revision() == binary_revision_) return;
-  binary_revision_ = map_.revision();
-  binary_map_publisher_.publish(binaryMapMessage());
+  mvog::MapBinary message;
+  {
+    std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
+    if (map_.revision() == binary_revision_) return;
+    binary_revision_ = map_.revision();
+    message = binaryMapMessage();
+  }
+  binary_map_publisher_.publish(message);
 }
 
 void Mapper::publishStatistics(const ros::TimerEvent&) {
@@ -459,11 +468,22 @@ void Mapper::decay(const ros::TimerEvent&) {
 }
 
 void Mapper::autosave() {
+  std::lock_guard<std::mutex> autosave_lock(autosave_mutex_);
   try {
-    std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
-    if (map_.revision() == saved_revision_) return;
-    mvog::saveMap(map_, resolveMapPath(config_.map_directory, config_.autosave_file, true));
-    saved_revision_ = map_.revision();
+    std::uint64_t generation = 0;
+    std::uint64_t revision = 0;
+    std::vector<std::uint8_t> bytes;
+    {
+      std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
+      generation = map_generation_;
+      revision = map_.revision();
+      if (generation == saved_generation_ && revision == saved_revision_) return;
+      bytes = mvog::serializeMap(map_);
+    }
+    // Written without the map's lock: insertion and queries go on meanwhile.
+    mvog::saveMapBytes(bytes, resolveMapPath(config_.map_directory, config_.autosave_file, true));
+    saved_generation_ = generation;
+    saved_revision_ = revision;
   } catch (const std::exception& e) {
     ROS_WARN_THROTTLE(kWarningPeriod, "mvog: autosave failed: %s", e.what());
   }
@@ -567,8 +587,12 @@ bool Mapper::getCrossSection(mvog::GetCrossSection::Request& request,
 bool Mapper::saveMap(mvog::MapFile::Request& request, mvog::MapFile::Response& response) {
   try {
     const std::string path = resolveMapPath(config_.map_directory, request.path, true);
-    std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
-    mvog::saveMap(map_, path);
+    std::vector<std::uint8_t> bytes;
+    {
+      std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
+      bytes = mvog::serializeMap(map_);
+    }
+    mvog::saveMapBytes(bytes, path);  // without the map's lock
     response.message = "saved " + path;
     response.success = true;
   } catch (const std::exception& e) {
@@ -607,7 +631,7 @@ void Mapper::replaceMap(mvog::Map&& map) {
   std::lock_guard<std::mutex> publish_lock(publish_mutex_);
   std::unique_lock<WriterPreferringMutex> lock(map_mutex_);
   map_ = std::move(map);
-  saved_revision_ = 0;  // revisions of the new map say nothing about the autosaved file
+  ++map_generation_;  // revisions of the new map say nothing about the autosaved file
   restartPublication();
 }
 

@@ -123,6 +123,7 @@ class Mapper {
 
   mutable WriterPreferringMutex map_mutex_;
   mvog::Map map_;
+  std::uint64_t map_generation_ = 0;  // how many maps replaceMap put in place (under map_mutex_)
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
@@ -138,6 +139,8 @@ class Mapper {
   std::mutex publish_mutex_;  // the publication state below
   std::uint64_t published_revision_ = 0;
   std::uint64_t binary_revision_ = 0;
+  std::mutex autosave_mutex_;           // one autosave at a time (timer, shutdown); guards saved_*
+  std::uint64_t saved_generation_ = 0;  // the map last autosaved, and its revision then
   std::uint64_t saved_revision_ = 0;
   /// Layer 0 is the projected map, then one per ~cross_section_heights entry.
   std::vector<IncrementalGrid> grids_;

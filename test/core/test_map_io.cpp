@@ -288,31 +288,45 @@ TEST(MapIo, FailedSaveThrowsAndLeavesNoTemporaryFile) {
 TEST(MapIo, SaveRemovesTheTemporariesOfKilledSavesOnly) {
   TempDir dir;
   const std::string path = dir.path() + "/map.mvog";
+  const std::string temporaries = dir.path() + "/.map.mvog.saving-";
   const std::string outside = dir.path() + "/outside";
   writeFile(outside, {7});
   // Left by a save killed before its rename: nobody holds it locked.
-  writeFile(path + ".tmp.Ab3xZ9", {1, 2});
+  writeFile(temporaries + "Ab3xZ9", {1, 2});
   // A save of the same path running in another process: locked (flock) until it renames.
-  const std::string running = path + ".tmp.Run123";
+  const std::string running = temporaries + "Run123";
   writeFile(running, {3});
   const int running_fd = ::open(running.c_str(), O_RDONLY);
   ASSERT_GE(running_fd, 0);
   ASSERT_EQ(::flock(running_fd, LOCK_EX), 0);
-  // Not temporaries of this path: another map's, a longer name, a link to a file elsewhere.
-  writeFile(dir.path() + "/other.mvog.tmp.Ab3xZ9", {4});
-  writeFile(path + ".tmp.Ab3xZ9x", {5});
-  ASSERT_EQ(::symlink(outside.c_str(), (path + ".tmp.Link00").c_str()), 0);
+  // Not temporaries of this path: another map's, a longer name, a user's file named like a
+  // temporary, a link to a file elsewhere, a FIFO (opening it must not block the save).
+  writeFile(dir.path() + "/.other.mvog.saving-Ab3xZ9", {4});
+  writeFile(temporaries + "Ab3xZ9x", {5});
+  writeFile(path + ".tmp.backup", {6});
+  ASSERT_EQ(::symlink(outside.c_str(), (temporaries + "Link00").c_str()), 0);
+  ASSERT_EQ(::mkfifo((temporaries + "Fifo00").c_str(), 0644), 0);
 
   saveMap(smallMap(), path);
   EXPECT_EQ(dir.entries(),
-            (std::set<std::string>{"map.mvog", "map.mvog.tmp.Run123", "map.mvog.tmp.Link00",
-                                   "map.mvog.tmp.Ab3xZ9x", "other.mvog.tmp.Ab3xZ9", "outside"}));
+            (std::set<std::string>{"map.mvog", ".map.mvog.saving-Run123", ".map.mvog.saving-Link00",
+                                   ".map.mvog.saving-Fifo00", ".map.mvog.saving-Ab3xZ9x",
+                                   ".other.mvog.saving-Ab3xZ9", "map.mvog.tmp.backup", "outside"}));
   EXPECT_EQ(readFile(outside), (Bytes{7}));
   EXPECT_TRUE(test::sameVolumes(allVolumes(loadMap(path)), allVolumes(smallMap())));
   // Once that save's process is gone (its lock with it), the next save removes its temporary.
   ::close(running_fd);
   saveMap(smallMap(), path);
-  EXPECT_EQ(dir.entries().count("map.mvog.tmp.Run123"), 0u);
+  EXPECT_EQ(dir.entries().count(".map.mvog.saving-Run123"), 0u);
+}
+
+TEST(MapIo, SaveMapBytesWritesWhatSerializeMapGave) {
+  TempDir dir;
+  const std::string path = dir.path() + "/map.mvog";
+  const Map map = test::randomMap(4, 0.1, 3.0);
+  saveMapBytes(serializeMap(map), path);
+  EXPECT_EQ(dir.entries(), (std::set<std::string>{"map.mvog"}));
+  EXPECT_TRUE(test::sameVolumes(allVolumes(loadMap(path)), allVolumes(map)));
 }
 
 TEST(MapIo, LoadRefusesMissingDirectoriesAndBrokenFiles) {

@@ -25,6 +25,7 @@ import mvog_reliability as rel
 
 KILLS = 10
 AUTOSAVE = "autosave.mvog"
+TEMPORARY_PREFIX = "." + AUTOSAVE + ".saving-"  # a save's temporary (include/mvog/map_io.h)
 
 
 def header_counts(path):
@@ -101,7 +102,7 @@ class KillDuringSave(unittest.TestCase):
                         server.wait_counter("messages_inserted", 3)
                         # Kill while a save is under way: once its temporary file exists.
                         def saving():
-                            return any(name.startswith(AUTOSAVE + ".tmp.")
+                            return any(name.startswith(TEMPORARY_PREFIX)
                                        for name in os.listdir(directory))
                         before = set(os.listdir(directory))
                         rel.wait_for_or_not(lambda: saving() and
@@ -110,14 +111,14 @@ class KillDuringSave(unittest.TestCase):
                     finally:
                         feeder.running = False
                         feeder.join()
-                    if any(name.startswith(AUTOSAVE + ".tmp.") and name not in before
+                    if any(name.startswith(TEMPORARY_PREFIX) and name not in before
                            for name in os.listdir(directory)):
                         kills_during_saves += 1
                     self.assertTrue(os.path.exists(path), "no autosave after kill %d" % kill)
                     header_counts(path)
                 finally:
                     server.stop()
-            leftovers = [n for n in os.listdir(directory) if n.startswith(AUTOSAVE + ".tmp.")]
+            leftovers = [n for n in os.listdir(directory) if n.startswith(TEMPORARY_PREFIX)]
             left_bytes = sum(os.path.getsize(os.path.join(directory, n)) for n in leftovers)
             print("\n%d SIGKILLs, %d of them during a save; %d restarts resumed the autosave; "
                   "%d temporaries (%d bytes) left beside it" % (KILLS, kills_during_saves, resumed,

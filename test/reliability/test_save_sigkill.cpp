@@ -54,7 +54,7 @@ std::vector<std::string> temporariesBeside(const std::string& directory, const s
   if (dir == nullptr) return found;
   while (const dirent* entry = ::readdir(dir)) {
     const std::string file = entry->d_name;
-    if (file.rfind(name + ".tmp.", 0) == 0) found.push_back(directory + "/" + file);
+    if (file.rfind("." + name + ".saving-", 0) == 0) found.push_back(directory + "/" + file);
   }
   ::closedir(dir);
   return found;

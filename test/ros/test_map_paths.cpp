@@ -127,6 +127,18 @@ TEST_F(MapPathsTest, RefusesWhatIsNotAFile) {
   expectRefusedBothWays(std::string("map.mvog\0/../x", 14));
 }
 
+TEST_F(MapPathsTest, RefusesHiddenNamesReservedForTheTemporariesOfSaves) {
+  touch(maps_ + "/.map.mvog.saving-Ab3xZ9");
+  expectRefusedBothWays(".map.mvog.saving-Ab3xZ9");  // would be removed by the next save
+  expectRefused(".new.mvog", true);
+  expectRefusedBothWays("sub/../.map.mvog.saving-Ab3xZ9");
+  link(maps_ + "/.map.mvog.saving-Ab3xZ9", "to_temporary.mvog");
+  expectRefusedBothWays("to_temporary.mvog");
+  // A hidden directory on the way is not a hidden name.
+  ASSERT_EQ(::mkdir((maps_ + "/.robot").c_str(), 0755), 0);
+  EXPECT_EQ(resolveMapPath(maps_, ".robot/map.mvog", true), maps_ + "/.robot/map.mvog");
+}
+
 TEST_F(MapPathsTest, RefusesAMissingMapDirectory) {
   EXPECT_THROW(resolveMapPath(maps_ + "/missing", "map.mvog", true), PathRefused);
 }
