@@ -173,7 +173,9 @@ class Map {
   std::vector<TileIndex> tilesModifiedSince(std::uint64_t revision) const;
   /// Cells covered by a tile (whether or not they hold volumes).
   static CellRange tileCells(const TileIndex& tile);
-  static TileIndex tileOf(const CellIndex& cell);
+  static TileIndex tileOf(const CellIndex& cell) {
+    return {cell.x >> kTileSizeLog2, cell.y >> kTileSizeLog2};  // arithmetic shift floors
+  }
 
   // ---- Direct access for serialisation ------------------------------------------------------
 

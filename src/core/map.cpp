@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <new>
 #include <thread>
 #include <utility>
@@ -232,10 +233,6 @@ Map::Map(const MapConfig& config) : config_(config) {
 Map::~Map() = default;
 Map::Map(Map&&) noexcept = default;
 Map& Map::operator=(Map&&) noexcept = default;
-
-TileIndex Map::tileOf(const CellIndex& cell) {
-  return {cell.x >> kTileSizeLog2, cell.y >> kTileSizeLog2};  // arithmetic shift floors
-}
 
 CellRange Map::tileCells(const TileIndex& tile) {
   const CellIndex min{tile.x * kTileSize, tile.y * kTileSize};
@@ -489,8 +486,7 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
   // in order but inserts only into the tiles it owns, so every cell receives exactly the volumes
   // of the single-threaded loop above, in the same order. Tiles a thread creates are kept aside
   // (the tile index is only read while the threads run) and added afterwards.
-  auto owner_of = [num_threads](const CellIndex& cell) {
-    const TileIndex t = tileOf(cell);
+  auto owner_of = [num_threads](const TileIndex& t) {
     const auto diagonal = static_cast<std::int64_t>(t.x) + t.y;
     const auto n = static_cast<std::int64_t>(num_threads);
     return static_cast<std::size_t>(((diagonal % n) + n) % n);
@@ -500,12 +496,21 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
   std::vector<CellRange> touched(num_threads, CellRange{{0, 0}, {-1, -1}});
   auto insert_owned = [&](std::size_t owner) {
     TileWriter writer(*this, &created[owner]);
+    // Consecutive cells of a ray mostly share a tile: its owner is computed once per tile.
+    TileIndex last_tile{std::numeric_limits<std::int32_t>::min(), 0};
+    bool owns_last_tile = false;
+    auto owns = [&](const CellIndex& cell) {
+      const TileIndex tile = tileOf(cell);
+      if (tile.x != last_tile.x || tile.y != last_tile.y) {
+        last_tile = tile;
+        owns_last_tile = owner_of(tile) == owner;
+      }
+      return owns_last_tile;
+    };
     for (const Reading& reading : readings) {
-      volumes_of(
-          reading, [&](const CellIndex& cell) { return owner_of(cell) == owner; },
-          [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
-            writer.insert(cell, sign, volume, unit_mass);
-          });
+      volumes_of(reading, owns, [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
+        writer.insert(cell, sign, volume, unit_mass);
+      });
     }
     bytes_added[owner] = writer.bytesAdded();
     touched[owner] = writer.touched();
