@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 
 namespace mvog {
@@ -46,13 +47,62 @@ inline Volume makeVolume(float z_a, float z_b, float unit_mass) {
   return volume;
 }
 
-/// Inserts `volume` into the sorted list `list[0, count)` (which satisfies the Sec. III-A
-/// constraints) and restores the constraints: volumes that overlap it (eq. 7) or lie within a gap
-/// of at most 1 (eq. 8) are merged into one with the summed mass plus, for every gap filled, the
-/// gap's mass at density 1 (times `unit_mass`). `list` must have room for count + 1 volumes.
-/// Returns the new count.
-std::uint32_t insertVolume(Volume* list, std::uint32_t count, const Volume& volume,
-                           float unit_mass);
+/// The run list[first, last) of the volumes that `volume` merges with when it is inserted into
+/// the sorted list `list[0, count)` (which satisfies the Sec. III-A constraints): those whose gap
+/// to it is at most kMaxMergeGap (a gap <= 0 is an overlap, eq. 7; a gap in (0, 1] is "too close",
+/// eq. 8). The list's own gaps exceed 1, so they are consecutive. first == last where it merges
+/// with none: it then goes in at `first` and the list grows by one.
+struct MergeRun {
+  std::uint32_t first = 0;
+  std::uint32_t last = 0;
+  bool addsVolume() const { return first == last; }
+};
+
+inline MergeRun findMergeRun(const Volume* list, std::uint32_t count, const Volume& volume) {
+  // Columns hold a handful of volumes: a linear scan beats a binary search there.
+  MergeRun run;
+  while (run.first != count && volume.bottom - list[run.first].top > kMaxMergeGap) ++run.first;
+  run.last = run.first;
+  while (run.last != count && list[run.last].bottom - volume.top <= kMaxMergeGap) ++run.last;
+  return run;
+}
+
+/// Inserts `volume` into `list[0, count)` at `run` (from findMergeRun on the same list) and
+/// restores the constraints: the volumes of the run are merged with it into one with the summed
+/// mass plus, for every gap filled, the gap's mass at density 1 (times `unit_mass`, eq. 8b).
+/// `list` must have room for count + 1 volumes when run.addsVolume(). Returns the new count.
+inline std::uint32_t insertVolumeAt(Volume* list, std::uint32_t count, const MergeRun& run,
+                                    const Volume& volume, float unit_mass) {
+  Volume* const first = list + run.first;
+  if (run.addsVolume()) {
+    std::memmove(first + 1, first, std::size_t{count - run.first} * sizeof(Volume));
+    *first = volume;
+    return count + 1;
+  }
+  Volume merged = volume;
+  float covered = volume.height();  // length of the union of the merged volumes
+  for (const Volume* v = first; v != list + run.last; ++v) {
+    const float overlap = std::min(v->top, volume.top) - std::max(v->bottom, volume.bottom);
+    covered += v->height() - std::max(0.0f, overlap);
+    merged.mass += v->mass;
+    merged.bottom = std::min(merged.bottom, v->bottom);
+    merged.top = std::max(merged.top, v->top);
+  }
+  merged.mass += std::max(0.0f, merged.height() - covered) * unit_mass;
+  *first = merged;
+  if (run.last != run.first + 1) {
+    std::memmove(first + 1, list + run.last, std::size_t{count - run.last} * sizeof(Volume));
+  }
+  return count - (run.last - run.first) + 1;
+}
+
+/// Inserts `volume` into the sorted list `list[0, count)` and restores the Sec. III-A
+/// constraints (findMergeRun, then insertVolumeAt). `list` must have room for count + 1
+/// volumes. Returns the new count.
+inline std::uint32_t insertVolume(Volume* list, std::uint32_t count, const Volume& volume,
+                                  float unit_mass) {
+  return insertVolumeAt(list, count, findMergeRun(list, count, volume), volume, unit_mass);
+}
 
 /// The volume of `list[0, count)` that contains height z, or nullptr.
 const Volume* findVolume(const Volume* list, std::uint32_t count, float z);

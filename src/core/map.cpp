@@ -72,33 +72,61 @@ class Map::Cell {
   std::size_t bytes() const { return block_ == nullptr ? 0 : blockBytes(block_->capacity); }
   std::int32_t exponent() const { return block_ == nullptr ? 0 : block_->exponent; }
 
+  /// The common case of insert(), done in place: a negative volume that merges into the list of
+  /// a cell written since the last decay (no block to grow, no mass to rescale). Returns false,
+  /// changing nothing, in every other case.
+  bool mergeNegative(const Volume& volume, float unit_mass, std::int64_t unit_exponent) {
+    if (block_ == nullptr || block_->exponent != unit_exponent) return false;
+    Volume* const list = volumes() + block_->num_positive;
+    const MergeRun run = findMergeRun(list, block_->num_negative, volume);
+    if (run.addsVolume()) return false;
+    block_->num_negative = insertVolumeAt(list, block_->num_negative, run, volume, unit_mass);
+    return true;
+  }
+
   /// Inserts `volume`, whose mass is in the unit of the map's current `unit_exponent`, with the
   /// constraints applied; returns the change of bytes held. The cell's masses are first brought
-  /// to that unit (exactly, by a power of two, unless they underflow).
+  /// to that unit (exactly, by a power of two, unless they underflow). The block grows only when
+  /// the list does (most insertions merge into a volume already there).
   std::ptrdiff_t insert(VolumeSign sign, const Volume& volume, float unit_mass,
                         std::int64_t unit_exponent) {
-    const bool fresh = block_ == nullptr;
-    const std::uint32_t total = fresh ? 0 : block_->num_positive + block_->num_negative;
-    const std::ptrdiff_t bytes_added = reserve(total + 1);
-    Volume* all = volumes();
-    if (!fresh && block_->exponent != unit_exponent) {
+    if (block_ == nullptr) {
+      const std::ptrdiff_t bytes_added = reserve(1);
+      block_->exponent = static_cast<std::int32_t>(unit_exponent);
+      (sign == VolumeSign::kPositive ? block_->num_positive : block_->num_negative) = 1;
+      volumes()[0] = volume;
+      return bytes_added;
+    }
+    const std::uint32_t total = block_->num_positive + block_->num_negative;
+    if (block_->exponent != unit_exponent) {
       // Decay since the last write lowered the unit exponent: unit_exponent < exponent.
       const auto shift = static_cast<int>(unit_exponent - block_->exponent);
+      Volume* all = volumes();
       for (std::uint32_t k = 0; k < total; ++k) all[k].mass = std::ldexp(all[k].mass, shift);
+      block_->exponent = static_cast<std::int32_t>(unit_exponent);
     }
-    block_->exponent = static_cast<std::int32_t>(unit_exponent);
-    std::uint32_t& num_positive = block_->num_positive;
-    std::uint32_t& num_negative = block_->num_negative;
-    if (sign == VolumeSign::kNegative) {
-      num_negative = insertVolume(all + num_positive, num_negative, volume, unit_mass);
+    const bool positive = sign == VolumeSign::kPositive;
+    const std::uint32_t offset = positive ? 0 : block_->num_positive;
+    const std::uint32_t count = positive ? block_->num_positive : block_->num_negative;
+    const MergeRun run = findMergeRun(volumes() + offset, count, volume);
+    std::ptrdiff_t bytes_added = 0;
+    if (run.addsVolume()) {
+      bytes_added = reserve(total + 1);
+      // The positive list grows into the negative list's place: move that one up first.
+      if (positive)
+        std::memmove(volumes() + count + 1, volumes() + count,
+                     std::size_t{block_->num_negative} * sizeof(Volume));
+    }
+    const std::uint32_t new_count =
+        insertVolumeAt(volumes() + offset, count, run, volume, unit_mass);
+    if (positive) {
+      // A merge that shrank the positive list leaves a hole before the negative list.
+      if (new_count < count)
+        std::memmove(volumes() + new_count, volumes() + count,
+                     std::size_t{block_->num_negative} * sizeof(Volume));
+      block_->num_positive = new_count;
     } else {
-      // Open a slot after the positive list, insert, and close what the merge left unused.
-      std::memmove(all + num_positive + 1, all + num_positive, num_negative * sizeof(Volume));
-      const std::uint32_t count = insertVolume(all, num_positive, volume, unit_mass);
-      if (count != num_positive + 1) {
-        std::memmove(all + count, all + num_positive + 1, num_negative * sizeof(Volume));
-      }
-      num_positive = count;
+      block_->num_negative = new_count;
     }
     return bytes_added;
   }
@@ -375,14 +403,26 @@ class Map::TileWriter {
   }
   void insert(const CellIndex& index, VolumeSign sign, const Volume& volume, float unit_mass) {
     Cell& target = cell(index);
-    // Only a cell receiving its first volume can lie outside the bounds of the cells with volumes.
-    if (target.empty()) include(touched_, {index, index});
-    bytes_added_ += target.insert(sign, volume, unit_mass, map_.unit_exponent_);
+    // Most volumes are free space merging into a volume already there: that case stays inline in
+    // the ray walk, everything else goes through Cell::insert.
+    if (sign == VolumeSign::kNegative &&
+        target.mergeNegative(volume, unit_mass, map_.unit_exponent_))
+      return;
+    insertAnyCase(target, index, sign, volume, unit_mass);
   }
   std::ptrdiff_t bytesAdded() const { return bytes_added_; }
   const CellRange& touched() const { return touched_; }
 
  private:
+  // Out of line (GCC and Clang both read the attribute), so that the rare cases do not crowd the
+  // registers of the ray walk that inlines insert().
+  __attribute__((noinline)) void insertAnyCase(Cell& target, const CellIndex& index,
+                                               VolumeSign sign, const Volume& volume,
+                                               float unit_mass) {
+    // Only a cell receiving its first volume can lie outside the bounds of the cells with volumes.
+    if (target.empty()) include(touched_, {index, index});
+    bytes_added_ += target.insert(sign, volume, unit_mass, map_.unit_exponent_);
+  }
   Tile* lookup(std::uint64_t key) {
     if (created_ == nullptr) {
       std::unique_ptr<Tile>& slot = map_.tiles_[key];

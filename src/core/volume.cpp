@@ -2,43 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 namespace mvog {
-
-std::uint32_t insertVolume(Volume* list, std::uint32_t count, const Volume& volume,
-                           float unit_mass) {
-  // Volumes to merge are those whose gap to `volume` is at most kMaxMergeGap (a gap <= 0 is an
-  // overlap, eq. 7; a gap in (0, 1] is "too close", eq. 8). The list is sorted and its own gaps
-  // exceed 1, so they form one run [first, last) and the merged volume is within 1 of no other.
-  Volume* const end = list + count;
-  // Columns hold a handful of volumes: a linear scan beats a binary search there.
-  Volume* first = list;
-  while (first != end && volume.bottom - first->top > kMaxMergeGap) ++first;
-  Volume* last = first;
-  while (last != end && last->bottom - volume.top <= kMaxMergeGap) ++last;
-  if (first == last) {
-    std::memmove(first + 1, first, static_cast<std::size_t>(end - first) * sizeof(Volume));
-    *first = volume;
-    return count + 1;
-  }
-  Volume merged = volume;
-  float covered = volume.height();  // length of the union of the merged volumes
-  for (const Volume* v = first; v != last; ++v) {
-    const float overlap = std::min(v->top, volume.top) - std::max(v->bottom, volume.bottom);
-    covered += v->height() - std::max(0.0f, overlap);
-    merged.mass += v->mass;
-    merged.bottom = std::min(merged.bottom, v->bottom);
-    merged.top = std::max(merged.top, v->top);
-  }
-  // Every gap that the merge fills is added at density 1 (eq. 8b).
-  merged.mass += std::max(0.0f, merged.height() - covered) * unit_mass;
-  *first = merged;
-  if (last != first + 1) {
-    std::memmove(first + 1, last, static_cast<std::size_t>(end - last) * sizeof(Volume));
-  }
-  return count - static_cast<std::uint32_t>(last - first) + 1;
-}
 
 const Volume* findVolume(const Volume* list, std::uint32_t count, float z) {
   const Volume* end = list + count;
