@@ -67,9 +67,26 @@ inline MergeRun findMergeRun(const Volume* list, std::uint32_t count, const Volu
   return run;
 }
 
+/// `volume` merged with the volumes [first, last) of a list that it overlaps or comes within
+/// kMaxMergeGap of: one volume spanning them all, with their summed mass (eq. 7) plus, for every
+/// gap filled, the gap's mass at density 1 (times `unit_mass`, eq. 8b).
+inline Volume mergedVolume(const Volume& volume, const Volume* first, const Volume* last,
+                           float unit_mass) {
+  Volume merged = volume;
+  float covered = volume.height();  // length of the union of the merged volumes
+  for (const Volume* v = first; v != last; ++v) {
+    const float overlap = std::min(v->top, volume.top) - std::max(v->bottom, volume.bottom);
+    covered += v->height() - std::max(0.0f, overlap);
+    merged.mass += v->mass;
+    merged.bottom = std::min(merged.bottom, v->bottom);
+    merged.top = std::max(merged.top, v->top);
+  }
+  merged.mass += std::max(0.0f, merged.height() - covered) * unit_mass;
+  return merged;
+}
+
 /// Inserts `volume` into `list[0, count)` at `run` (from findMergeRun on the same list) and
-/// restores the constraints: the volumes of the run are merged with it into one with the summed
-/// mass plus, for every gap filled, the gap's mass at density 1 (times `unit_mass`, eq. 8b).
+/// restores the constraints: the volumes of the run are merged with it (mergedVolume).
 /// `list` must have room for count + 1 volumes when run.addsVolume(). Returns the new count.
 inline std::uint32_t insertVolumeAt(Volume* list, std::uint32_t count, const MergeRun& run,
                                     const Volume& volume, float unit_mass) {
@@ -79,17 +96,7 @@ inline std::uint32_t insertVolumeAt(Volume* list, std::uint32_t count, const Mer
     *first = volume;
     return count + 1;
   }
-  Volume merged = volume;
-  float covered = volume.height();  // length of the union of the merged volumes
-  for (const Volume* v = first; v != list + run.last; ++v) {
-    const float overlap = std::min(v->top, volume.top) - std::max(v->bottom, volume.bottom);
-    covered += v->height() - std::max(0.0f, overlap);
-    merged.mass += v->mass;
-    merged.bottom = std::min(merged.bottom, v->bottom);
-    merged.top = std::max(merged.top, v->top);
-  }
-  merged.mass += std::max(0.0f, merged.height() - covered) * unit_mass;
-  *first = merged;
+  *first = mergedVolume(volume, first, list + run.last, unit_mass);
   if (run.last != run.first + 1) {
     std::memmove(first + 1, list + run.last, std::size_t{count - run.last} * sizeof(Volume));
   }
