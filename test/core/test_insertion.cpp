@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -391,6 +392,70 @@ TEST(Insertion, ScanEqualsReadingByReading) {
   EXPECT_EQ(by_scan.bounds().max, by_reading.bounds().max);
   EXPECT_LT(by_scan.bounds().min.x, 0);
   EXPECT_LT(by_scan.bounds().min.y, 0);
+}
+
+TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
+  // Vertical readings reach one cell each, so what each cell must hold follows from makeVolume
+  // and insertVolume alone (Sec. III-B.2: an obstacle's positive volume, then the padding below
+  // or above it; free space from the start to the end of an out-of-range reading). Many readings
+  // into 2 x 2 cells make both lists of each cell grow, merge, shrink and grow again, which the
+  // map does in one block per cell, with fast paths for the common merges: the map must hold
+  // exactly the lists that the rules give, bit for bit, every step of the way.
+  Map map(unitConfig());
+  std::vector<std::vector<Volume>> positive(4);
+  std::vector<std::vector<Volume>> negative(4);
+  auto insert_into = [](std::vector<Volume>& list, const Volume& volume) {
+    list.push_back({});
+    const auto count = static_cast<std::uint32_t>(list.size() - 1);
+    list.resize(insertVolume(list.data(), count, volume, 1.0f));
+  };
+  // Short rays at one of 8 levels 12 apart: volumes of one level merge, different levels stay
+  // apart, so the lists hold up to 8 volumes and a volume bridging two of a level shrinks them.
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> level_of(0, 7);
+  std::uniform_int_distribution<int> quarters(0, 8);
+  std::uniform_int_distribution<int> length_in_eighths(1, 20);
+  std::uniform_int_distribution<int> cell_of(0, 3);
+  std::bernoulli_distribution is_obstacle(0.4);
+  std::bernoulli_distribution upwards(0.5);
+  for (int step = 0; step < 4000; ++step) {
+    const int c = cell_of(rng);
+    const double x = (c % 2) + 0.5;
+    const double y = (c / 2) + 0.5;
+    const double z0 = 12.0 * level_of(rng) + quarters(rng) / 4.0;
+    const double length = length_in_eighths(rng) / 8.0;
+    const double z1 = upwards(rng) ? z0 + length : z0 - length;
+    const bool obstacle = is_obstacle(rng);
+    map.insertReading({x, y, z0}, {x, y, z1}, obstacle);
+    const auto start_z = static_cast<float>(z0);
+    const auto end_z = static_cast<float>(z1);
+    if (obstacle) {
+      const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f, 1.0f);
+      insert_into(positive[c], hit);
+      if (std::fabs(z0 - z1) > 1.0) {
+        insert_into(negative[c], makeVolume(start_z, z0 < z1 ? hit.bottom : hit.top, 1.0f));
+      }
+    } else {
+      insert_into(negative[c], makeVolume(start_z, end_z, 1.0f));
+    }
+    const CellVolumes held = map.cellVolumes({c % 2, c / 2});
+    auto same = [](const std::vector<Volume>& a, const std::vector<Volume>& b) {
+      return a.size() == b.size() &&
+             std::memcmp(a.data(), b.data(), a.size() * sizeof(Volume)) == 0;
+    };
+    ASSERT_TRUE(same(held.positive, positive[c]))
+        << "positive list of cell " << c << ", step " << step;
+    ASSERT_TRUE(same(held.negative, negative[c]))
+        << "negative list of cell " << c << ", step " << step;
+  }
+  std::size_t most_positive = 0;
+  std::size_t most_negative = 0;
+  for (int c = 0; c < 4; ++c) {
+    most_positive = std::max(most_positive, positive[c].size());
+    most_negative = std::max(most_negative, negative[c].size());
+  }
+  EXPECT_GE(most_positive, 3u);  // the lists did hold several volumes
+  EXPECT_GE(most_negative, 2u);
 }
 
 TEST(Insertion, SplitScanPiecesInsertedInOrderBuildTheSameMap) {
