@@ -367,14 +367,20 @@ template <class Owns, class Emit>
 void volumesOfReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
                       bool model_negative_space, float unit_mass,
                       const ScanPositives* scan_positives, Owns&& owns, Emit&& emit) {
+  const float end_z = static_cast<float>(end.z());
+  auto obstacle_volume = [&] { return makeVolume(end_z - 0.5f, end_z + 0.5f, unit_mass); };
+  if (!model_negative_space) {
+    // Only the obstacle's own volume, in the cell the walk would end in (see walkRay): no walk.
+    const CellIndex cell = cellAt(end.x(), end.y());
+    if (obstacle && owns(cell)) emit(cell, VolumeSign::kPositive, obstacle_volume());
+    return;
+  }
   auto emit_negative = [&](const CellIndex& cell, double z_a, double z_b) {
-    if (!model_negative_space) return;
     const Volume negative = makeVolume(static_cast<float>(z_a), static_cast<float>(z_b), unit_mass);
     if (scan_positives == nullptr || !conflictsWithScan(*scan_positives, cell, negative)) {
       emit(cell, VolumeSign::kNegative, negative);
     }
   };
-  const float end_z = static_cast<float>(end.z());
   walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
           [&](const CellIndex& cell, double z_enter, double z_exit, bool is_last) {
             if (!owns(cell)) return;
@@ -382,7 +388,7 @@ void volumesOfReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, 
               emit_negative(cell, z_enter, z_exit);  // eqs. (3) and (4)
               return;
             }
-            const Volume positive = makeVolume(end_z - 0.5f, end_z + 0.5f, unit_mass);  // eq. (5)
+            const Volume positive = obstacle_volume();  // eq. (5)
             emit(cell, VolumeSign::kPositive, positive);
             if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
               emit_negative(cell, z_enter, z_enter < end.z() ? positive.bottom : positive.top);
