@@ -70,9 +70,19 @@ source_workspace() {
 # in the background and added to BACKGROUND_PIDS is stopped on exit, whatever happens.
 BACKGROUND_PIDS=()
 stop_background_processes() {
-  for pid in "${BACKGROUND_PIDS[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
-  sleep 1
-  for pid in "${BACKGROUND_PIDS[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
+  # Newest first, each given a few seconds to exit: rviz must close before the X server it draws
+  # on (it aborts when the display goes), nodes before their master.
+  local k pid tries
+  for ((k = ${#BACKGROUND_PIDS[@]} - 1; k >= 0; k--)); do
+    pid=${BACKGROUND_PIDS[k]}
+    kill -INT "$pid" 2>/dev/null || continue
+    for ((tries = 0; tries < 25; tries++)); do
+      kill -0 "$pid" 2>/dev/null || break
+      sleep 0.2
+    done
+    kill -KILL "$pid" 2>/dev/null || true
+    { wait "$pid"; } 2>/dev/null || true
+  done
 }
 start_private_master() {
   local port
