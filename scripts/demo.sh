@@ -67,10 +67,10 @@ rosparam set /mvog_mapper/cross_section_heights "$heights_yaml" 2>/dev/null || t
 screenshot=""
 if command -v Xvfb >/dev/null && command -v rviz >/dev/null; then
   # Xvfb picks a free display itself and writes its number to the file descriptor given.
-  Xvfb -displayfd 3 -screen 0 1280x900x24 3>"$output/.xvfb-display" >"$LOG_DIR/demo-xvfb.log" 2>&1 &
+  Xvfb -displayfd 3 -screen 0 1280x900x24 3>"$LOG_DIR/demo-xvfb-display" >"$LOG_DIR/demo-xvfb.log" 2>&1 &
   BACKGROUND_PIDS+=($!)
-  for _ in $(seq 50); do [ -s "$output/.xvfb-display" ] && break; sleep 0.2; done
-  display=:$(cat "$output/.xvfb-display")
+  for _ in $(seq 50); do [ -s "$LOG_DIR/demo-xvfb-display" ] && break; sleep 0.2; done
+  display=:$(cat "$LOG_DIR/demo-xvfb-display")
   DISPLAY=$display rviz -d "$REPO/rviz/mvog.rviz" >"$LOG_DIR/demo-rviz.log" 2>&1 &
   BACKGROUND_PIDS+=($!)
 fi
