@@ -67,6 +67,7 @@ rosparam set /mvog_mapper/cross_section_heights "$heights_yaml" 2>/dev/null || t
 screenshot=""
 if command -v Xvfb >/dev/null && command -v rviz >/dev/null; then
   # Xvfb picks a free display itself and writes its number to the file descriptor given.
+  rm -f "$LOG_DIR/demo-xvfb-display"  # the loop below must not read a previous run's number
   Xvfb -displayfd 3 -screen 0 1280x900x24 3>"$LOG_DIR/demo-xvfb-display" >"$LOG_DIR/demo-xvfb.log" 2>&1 &
   BACKGROUND_PIDS+=($!)
   for _ in $(seq 50); do [ -s "$LOG_DIR/demo-xvfb-display" ] && break; sleep 0.2; done

@@ -123,17 +123,19 @@ class Map::Cell {
     if (run.addsVolume()) {
       bytes_added = reserve(total + 1);
       // The positive list grows into the negative list's place: move that one up first.
-      if (positive)
+      if (positive) {
         std::memmove(volumes() + count + 1, volumes() + count,
                      std::size_t{block_->num_negative} * sizeof(Volume));
+      }
     }
     const std::uint32_t new_count =
         insertVolumeAt(volumes() + offset, count, run, volume, unit_mass);
     if (positive) {
       // A merge that shrank the positive list leaves a hole before the negative list.
-      if (new_count < count)
+      if (new_count < count) {
         std::memmove(volumes() + new_count, volumes() + count,
                      std::size_t{block_->num_negative} * sizeof(Volume));
+      }
       block_->num_positive = new_count;
     } else {
       block_->num_negative = new_count;
