@@ -40,8 +40,14 @@ inline Volume makeVolume(float z_a, float z_b, float unit_mass) {
     const float centre = 0.5f * (volume.bottom + volume.top);  // eq. (6)
     volume.bottom = centre - 0.5f * kMinVolumeHeight;
     volume.top = centre + 0.5f * kMinVolumeHeight;
-    // The float sum may round to just under the minimum height; nudge the top up to it.
-    while (volume.height() < kMinVolumeHeight) volume.top = std::nextafter(volume.top, INFINITY);
+    // The float sums may round to just under the minimum height. Then raise the top to
+    // bottom + 1, and one float further if that sum rounds down too (then it lies above it).
+    // Nudging the top up one float at a time until the height is 1, as before, could take
+    // billions of steps when the top lies just below zero (found by fuzzing).
+    if (volume.height() < kMinVolumeHeight) {
+      volume.top = std::max(volume.top, volume.bottom + kMinVolumeHeight);
+      if (volume.height() < kMinVolumeHeight) volume.top = std::nextafter(volume.top, INFINITY);
+    }
   }
   volume.mass = volume.height() * unit_mass;
   return volume;

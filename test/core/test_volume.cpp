@@ -92,6 +92,26 @@ TEST(MakeVolume, MinimumHeightHoldsFarFromZero) {
   }
 }
 
+TEST(MakeVolume, MinimumHeightHoldsNearZero) {
+  // Centres just below -0.5 put the top just below zero, where floats are dense: a top nudged up
+  // one float at a time needed billions of steps there (a fuzzer's input hung the server). The
+  // volume is still at least 1 high, and as short as the rounding allows.
+  for (float c : {-0.50000006f, -0.5000001f, -0.49999997f, 0.49999997f, -0.5f}) {
+    const Volume v = makeVolume(c, c, 1.0f);
+    EXPECT_GE(v.top - v.bottom, 1.0f) << "centre " << c;
+    EXPECT_LT(v.top - v.bottom, 1.0f + 1e-6f) << "centre " << c;
+    EXPECT_LE(v.bottom, c) << "centre " << c;
+    EXPECT_GE(v.top, c) << "centre " << c;
+  }
+  // Every centre between -0.5 - 2^-20 and -0.5 + 2^-20, float by float.
+  for (float c = -0.5f - 9.5367431640625e-07f; c < -0.5f + 9.5367431640625e-07f;
+       c = std::nextafter(c, 1.0f)) {
+    const Volume v = makeVolume(c, c, 1.0f);
+    ASSERT_GE(v.top - v.bottom, 1.0f) << "centre " << c;
+    ASSERT_LT(v.top - v.bottom, 1.0f + 1e-6f) << "centre " << c;
+  }
+}
+
 // ---- Eq. (7): overlapping volumes merge with summed masses -----------------------------------
 
 TEST(InsertVolume, IntoEmptyList) {
