@@ -65,8 +65,13 @@ struct MergeRun {
 };
 
 inline MergeRun findMergeRun(const Volume* list, std::uint32_t count, const Volume& volume) {
-  // Columns hold a handful of volumes: a linear scan beats a binary search there.
   MergeRun run;
+  if (count == 1) {
+    // The commonest column, one volume (free space above a floor, say): no scan.
+    if (volume.bottom - list[0].top > kMaxMergeGap) return {1, 1};
+    return {0, list[0].bottom - volume.top <= kMaxMergeGap ? 1u : 0u};
+  }
+  // Columns hold a handful of volumes: a linear scan beats a binary search there.
   while (run.first != count && volume.bottom - list[run.first].top > kMaxMergeGap) ++run.first;
   run.last = run.first;
   while (run.last != count && list[run.last].bottom - volume.top <= kMaxMergeGap) ++run.last;
@@ -102,10 +107,13 @@ inline std::uint32_t insertVolumeAt(Volume* list, std::uint32_t count, const Mer
     *first = volume;
     return count + 1;
   }
-  *first = mergedVolume(volume, first, list + run.last, unit_mass);
-  if (run.last != run.first + 1) {
-    std::memmove(first + 1, list + run.last, std::size_t{count - run.last} * sizeof(Volume));
+  if (run.last == run.first + 1) {
+    // The commonest merge, with one volume: the list keeps its length, nothing moves.
+    *first = mergedVolume(volume, first, first + 1, unit_mass);
+    return count;
   }
+  *first = mergedVolume(volume, first, list + run.last, unit_mass);
+  std::memmove(first + 1, list + run.last, std::size_t{count - run.last} * sizeof(Volume));
   return count - (run.last - run.first) + 1;
 }
 

@@ -78,16 +78,6 @@ class Map::Cell {
   bool mergeNegative(const Volume& volume, float unit_mass, std::int64_t unit_exponent) {
     if (block_ == nullptr || block_->exponent != unit_exponent) return false;
     Volume* const list = volumes() + block_->num_positive;
-    if (block_->num_negative == 1) {
-      // Most columns hold one free-space volume (95 % of the visits on a depth camera's frames):
-      // the same merge as below without the searches.
-      Volume& only = list[0];
-      if (volume.bottom - only.top > kMaxMergeGap || only.bottom - volume.top > kMaxMergeGap) {
-        return false;
-      }
-      only = mergedVolume(volume, &only, &only + 1, unit_mass);
-      return true;
-    }
     const MergeRun run = findMergeRun(list, block_->num_negative, volume);
     if (run.addsVolume()) return false;
     block_->num_negative = insertVolumeAt(list, block_->num_negative, run, volume, unit_mass);
