@@ -39,7 +39,7 @@ struct InsertionConfig {
   /// by the same scan in the same cell is not inserted.
   bool clear_conflicting_free_space = false;
   /// Threads used by Map::insertScan; the resulting map is identical for any count.
-  int num_threads = 1;
+  int insertion_threads = 1;
 
   /// Throws ConfigError naming the first invalid field.
   void validate() const;

@@ -17,13 +17,20 @@
 
 namespace mvog {
 
+/// What a range reading saw (Sec. III-B.1): an obstacle at its end, or nothing up to its end.
+enum class ReadingKind : std::uint8_t {
+  kObstacle,   ///< the ray hit something at its end: free space along it, occupied at the end
+  kOutOfRange  ///< no return (or beyond the range limit): free space along it only
+};
+
 /// One scan (or point cloud) taken from one origin, in the map frame, metres.
 struct Scan {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   /// Obstacle readings: the points where a ray hit something.
   std::vector<Eigen::Vector3f> hits;
-  /// Out-of-range readings: where the free space seen along a ray ends (no obstacle there).
-  std::vector<Eigen::Vector3f> free_endpoints;
+  /// Out-of-range readings (ReadingKind::kOutOfRange): where the free space seen along a ray
+  /// ends, with no obstacle there.
+  std::vector<Eigen::Vector3f> out_of_range;
 };
 
 /// Splits `scan` into consecutive pieces of at most `max_readings` readings each (its hits, then
@@ -116,9 +123,9 @@ class Map {
 
   // ---- Insertion (Sec. III-B) ------------------------------------------------------------
 
-  /// Inserts one obstacle reading (`is_obstacle`) or out-of-range reading ending at `end`.
+  /// Inserts one reading ending at `end`: an obstacle reading, or an out-of-range reading.
   InsertionResult insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
-                                bool is_obstacle, const InsertionConfig& config = {});
+                                ReadingKind kind, const InsertionConfig& config = {});
   /// Inserts a whole scan: the same map as inserting its hits, then its free endpoints, one by
   /// one in order (unless config.clear_conflicting_free_space), with any number of threads.
   InsertionResult insertScan(const Scan& scan, const InsertionConfig& config = {});

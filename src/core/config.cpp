@@ -27,7 +27,8 @@ void InsertionConfig::validate() const {
   require(!std::isnan(max_range) && max_range > 0.0, "max_range",
           "must be > 0 (infinity for no limit)");
   require(min_range < max_range, "min_range", "must be smaller than max_range");
-  require(num_threads >= 1 && num_threads <= 256, "num_threads", "must be in [1, 256]");
+  require(insertion_threads >= 1 && insertion_threads <= 256, "insertion_threads",
+          "must be in [1, 256]");
 }
 
 }  // namespace mvog

@@ -215,7 +215,7 @@ std::vector<Scan> splitScan(const Scan& scan, std::size_t max_readings) {
   std::vector<Scan> pieces;
   auto piece_with_room = [&]() -> Scan& {
     if (pieces.empty() ||
-        pieces.back().hits.size() + pieces.back().free_endpoints.size() == max_readings) {
+        pieces.back().hits.size() + pieces.back().out_of_range.size() == max_readings) {
       pieces.emplace_back().origin = scan.origin;
     }
     return pieces.back();
@@ -226,12 +226,12 @@ std::vector<Scan> splitScan(const Scan& scan, std::size_t max_readings) {
     piece.hits.assign(scan.hits.begin() + next, scan.hits.begin() + next + count);
     next += count;
   }
-  for (std::size_t next = 0; next < scan.free_endpoints.size();) {
+  for (std::size_t next = 0; next < scan.out_of_range.size();) {
     Scan& piece = piece_with_room();
-    const std::size_t room = max_readings - piece.hits.size() - piece.free_endpoints.size();
-    const std::size_t count = std::min(room, scan.free_endpoints.size() - next);
-    piece.free_endpoints.insert(piece.free_endpoints.end(), scan.free_endpoints.begin() + next,
-                                scan.free_endpoints.begin() + next + count);
+    const std::size_t room = max_readings - piece.hits.size() - piece.out_of_range.size();
+    const std::size_t count = std::min(room, scan.out_of_range.size() - next);
+    piece.out_of_range.insert(piece.out_of_range.end(), scan.out_of_range.begin() + next,
+                              scan.out_of_range.begin() + next + count);
     next += count;
   }
   return pieces;
@@ -455,7 +455,8 @@ class Map::TileWriter {
 };
 
 InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
-                                   bool is_obstacle, const InsertionConfig& config) {
+                                   ReadingKind kind, const InsertionConfig& config) {
+  const bool is_obstacle = kind == ReadingKind::kObstacle;
   config.validate();
   InsertionResult result;
   Eigen::Vector3d ray_end;
@@ -483,7 +484,7 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
     bool obstacle;
   };
   std::vector<Reading> readings;
-  readings.reserve(scan.hits.size() + scan.free_endpoints.size());
+  readings.reserve(scan.hits.size() + scan.out_of_range.size());
   const Eigen::Vector3d& origin = scan.origin;
   auto accept = [&](const Eigen::Vector3f& end, bool is_obstacle) {
     Eigen::Vector3d ray_end;
@@ -493,7 +494,7 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
     }
   };
   for (const Eigen::Vector3f& hit : scan.hits) accept(hit, true);
-  for (const Eigen::Vector3f& end : scan.free_endpoints) accept(end, false);
+  for (const Eigen::Vector3f& end : scan.out_of_range) accept(end, false);
   if (readings.empty()) return result;
   ++revision_;
 
@@ -515,8 +516,8 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
                      scan_positives.get(), owns, emit);
   };
 
-  const auto num_threads = static_cast<std::size_t>(config.num_threads);
-  if (num_threads == 1) {
+  const auto insertion_threads = static_cast<std::size_t>(config.insertion_threads);
+  if (insertion_threads == 1) {
     TileWriter writer(*this, nullptr);
     for (const Reading& reading : readings) {
       volumes_of(
@@ -534,14 +535,14 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
   // in order but inserts only into the tiles it owns, so every cell receives exactly the volumes
   // of the single-threaded loop above, in the same order. Tiles a thread creates are kept aside
   // (the tile index is only read while the threads run) and added afterwards.
-  auto owner_of = [num_threads](const TileIndex& t) {
+  auto owner_of = [insertion_threads](const TileIndex& t) {
     const auto diagonal = static_cast<std::int64_t>(t.x) + t.y;
-    const auto n = static_cast<std::int64_t>(num_threads);
+    const auto n = static_cast<std::int64_t>(insertion_threads);
     return static_cast<std::size_t>(((diagonal % n) + n) % n);
   };
-  std::vector<std::unordered_map<std::uint64_t, std::unique_ptr<Tile>>> created(num_threads);
-  std::vector<std::ptrdiff_t> bytes_added(num_threads, 0);
-  std::vector<CellRange> touched(num_threads, CellRange{{0, 0}, {-1, -1}});
+  std::vector<std::unordered_map<std::uint64_t, std::unique_ptr<Tile>>> created(insertion_threads);
+  std::vector<std::ptrdiff_t> bytes_added(insertion_threads, 0);
+  std::vector<CellRange> touched(insertion_threads, CellRange{{0, 0}, {-1, -1}});
   auto insert_owned = [&](std::size_t owner) {
     TileWriter writer(*this, &created[owner]);
     // Consecutive cells of a ray mostly share a tile: its owner is computed once per tile.
@@ -564,11 +565,11 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
     touched[owner] = writer.touched();
   };
   std::vector<std::thread> workers;
-  for (std::size_t owner = 1; owner < num_threads; ++owner)
+  for (std::size_t owner = 1; owner < insertion_threads; ++owner)
     workers.emplace_back(insert_owned, owner);
   insert_owned(0);
   for (std::thread& worker : workers) worker.join();
-  for (std::size_t owner = 0; owner < num_threads; ++owner) {
+  for (std::size_t owner = 0; owner < insertion_threads; ++owner) {
     for (auto& entry : created[owner]) tiles_.emplace(entry.first, std::move(entry.second));
     bytes_in_cells_ += bytes_added[owner];
     growBounds(touched[owner]);

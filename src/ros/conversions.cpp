@@ -61,7 +61,7 @@ mvog::Scan scanToReadings(const sensor_msgs::LaserScan& scan,
     if (std::isfinite(range) && range >= scan.range_min && range <= scan.range_max) {
       readings.hits.push_back((map_from_sensor * (range * direction)).cast<float>());
     } else if (range == std::numeric_limits<double>::infinity() || range > scan.range_max) {
-      readings.free_endpoints.push_back((map_from_sensor * (free_range * direction)).cast<float>());
+      readings.out_of_range.push_back((map_from_sensor * (free_range * direction)).cast<float>());
     } else {
       ++skipped_beams;
     }

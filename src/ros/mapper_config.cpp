@@ -106,14 +106,12 @@ std::string defaultMapDirectory() {
 }  // namespace
 
 void MapperConfig::validate() const {
-  // The core's own checks name their field; prefix them with the parameter's ~.
+  // The core's own checks name their field, which is the parameter's name: prefix it with ~.
   try {
     map.validate();
     insertion.validate();
   } catch (const mvog::ConfigError& e) {
-    std::string message = e.what();
-    if (message.rfind("num_threads", 0) == 0) message.replace(0, 11, "insertion_threads");
-    throw mvog::ConfigError("~" + message);
+    throw mvog::ConfigError(std::string("~") + e.what());
   }
   require(!frame_id.empty() && frame_id.front() != '/', "frame_id",
           "must be a non-empty tf2 frame id (without a leading '/')");
@@ -164,7 +162,7 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   read(nh, "insert_out_of_range", config.insertion.insert_out_of_range);
   read(nh, "model_negative_space", config.insertion.model_negative_space);
   read(nh, "clear_conflicting_free_space", config.insertion.clear_conflicting_free_space);
-  read(nh, "insertion_threads", config.insertion.num_threads);
+  read(nh, "insertion_threads", config.insertion.insertion_threads);
   read(nh, "frame_id", config.frame_id);
   read(nh, "scan_topics", config.scan_topics);
   read(nh, "cloud_topics", config.cloud_topics);

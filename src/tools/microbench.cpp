@@ -65,7 +65,7 @@ mvog::Scan depthScan(const Eigen::Vector3d& position, double yaw) {
       if (range <= kMaxRange) {
         scan.hits.push_back((position + range * direction).cast<float>());
       } else {
-        scan.free_endpoints.push_back((position + kMaxRange * direction).cast<float>());
+        scan.out_of_range.push_back((position + kMaxRange * direction).cast<float>());
       }
     }
   }
@@ -89,7 +89,7 @@ const std::vector<mvog::Scan>& roomScans() {
 mvog::InsertionConfig insertionConfig(int threads) {
   mvog::InsertionConfig config;
   config.max_range = kMaxRange;
-  config.num_threads = threads;
+  config.insertion_threads = threads;
   return config;
 }
 
@@ -114,7 +114,8 @@ void BM_InsertReading(benchmark::State& state) {
   std::size_t next = 0;
   for (auto _ : state) {
     const Eigen::Vector3d end = scan.hits[next].cast<double>();
-    benchmark::DoNotOptimize(map.insertReading(scan.origin, end, true, config));
+    benchmark::DoNotOptimize(
+        map.insertReading(scan.origin, end, mvog::ReadingKind::kObstacle, config));
     next = (next + 997) % scan.hits.size();  // spread over the image
   }
   state.SetItemsProcessed(state.iterations());
@@ -130,7 +131,7 @@ void BM_InsertScan(benchmark::State& state) {
   for (auto _ : state) {
     const mvog::Scan& scan = scans[next];
     benchmark::DoNotOptimize(map.insertScan(scan, config));
-    readings += scan.hits.size() + scan.free_endpoints.size();
+    readings += scan.hits.size() + scan.out_of_range.size();
     next = (next + 1) % scans.size();
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(readings));

@@ -84,7 +84,7 @@ mvog::Scan depthScan(const std::vector<Box>& boxes, const Eigen::Vector3d& posit
       if (range <= max_range) {
         scan.hits.push_back((position + range * direction).cast<float>());
       } else {
-        scan.free_endpoints.push_back((position + max_range * direction).cast<float>());
+        scan.out_of_range.push_back((position + max_range * direction).cast<float>());
       }
     }
   }

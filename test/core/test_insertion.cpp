@@ -24,7 +24,7 @@ using test::volumeIs;
 
 TEST(Insertion, Fig3LeftRayHasPaddingVolume) {
   Map map(unitConfig());
-  const InsertionResult result = map.insertReading({0, 0, 0}, {0, 4.5, 10}, true);
+  const InsertionResult result = map.insertReading({0, 0, 0}, {0, 4.5, 10}, ReadingKind::kObstacle);
   EXPECT_EQ(result.obstacle_readings, 1u);
   // x = 0 lies in cell i = 0. The projection runs along +y from 0 to 4.5 through cells
   // j = 0..4; the ray rises z = (10 / 4.5) y, so it crosses the wall y = j at z = 2.222 j.
@@ -54,7 +54,7 @@ TEST(Insertion, Fig3LeftRayHasPaddingVolume) {
 
 TEST(Insertion, Fig3RightRayHasNoPaddingVolume) {
   Map map(unitConfig());
-  map.insertReading({0, 0, 0}, {0, 10.5, 4}, true);
+  map.insertReading({0, 0, 0}, {0, 10.5, 4}, ReadingKind::kObstacle);
   // Cells j = 0..10 along +y; z = (4 / 10.5) y crosses the wall y = j at z = 0.381 j.
   const double slope = 4.0 / 10.5;
   for (int j = 0; j < 10; ++j) {
@@ -78,7 +78,8 @@ TEST(Insertion, Fig3RightRayHasNoPaddingVolume) {
 
 TEST(Insertion, Fig3LeftRayAsOutOfRangeReadingIsFreeUpToItsEnd) {
   Map map(unitConfig());
-  const InsertionResult result = map.insertReading({0, 0, 0}, {0, 4.5, 10}, false);
+  const InsertionResult result =
+      map.insertReading({0, 0, 0}, {0, 4.5, 10}, ReadingKind::kOutOfRange);
   EXPECT_EQ(result.out_of_range_readings, 1u);
   EXPECT_EQ(result.obstacle_readings, 0u);
   // Cells j = 0..3 as for the obstacle reading; the last cell gets eq. (4):
@@ -102,7 +103,7 @@ TEST(Insertion, Fig3LeftRayAsOutOfRangeReadingIsFreeUpToItsEnd) {
 
 TEST(Insertion, DescendingRayPadsDownToTheObstacleTop) {
   Map map(unitConfig());
-  map.insertReading({0.5, 0.5, 10}, {1.5, 0.5, 0}, true);
+  map.insertReading({0.5, 0.5, 10}, {1.5, 0.5, 0}, ReadingKind::kObstacle);
   // Cell (0, 0): z from 10 down to 5 at the wall x = 1: eq. (3) gives [5, 10], mass 5.
   const CellVolumes first = map.cellVolumes({0, 0});
   ASSERT_EQ(first.negative.size(), 1u);
@@ -118,7 +119,7 @@ TEST(Insertion, DescendingRayPadsDownToTheObstacleTop) {
 
 TEST(Insertion, EntryExactlyOneAboveTheObstacleNeedsNoPadding) {
   Map map(unitConfig());
-  map.insertReading({0.5, 0.5, 0}, {1.5, 0.5, 2}, true);
+  map.insertReading({0.5, 0.5, 0}, {1.5, 0.5, 2}, ReadingKind::kObstacle);
   // Cell (0, 0): [0, 1] (height exactly 1). Cell (1, 0): z_enter = 1, L'_z = 2, |1 - 2| = 1 <= 1:
   // only V = [1.5, 2.5].
   const CellVolumes first = map.cellVolumes({0, 0});
@@ -133,14 +134,14 @@ TEST(Insertion, EntryExactlyOneAboveTheObstacleNeedsNoPadding) {
 TEST(Insertion, VerticalRays) {
   Map map(unitConfig());
   // Straight up 5: one cell, z_enter = 0, L'_z = 5: V = [4.5, 5.5], V' = [0, 4.5] (mass 4.5).
-  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, true);
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, ReadingKind::kObstacle);
   CellVolumes cell = map.cellVolumes({0, 0});
   ASSERT_EQ(cell.positive.size(), 1u);
   ASSERT_EQ(cell.negative.size(), 1u);
   EXPECT_TRUE(volumeIs(cell.positive[0], 4.5, 5.5, 1.0));
   EXPECT_TRUE(volumeIs(cell.negative[0], 0.0, 4.5, 4.5));
   // Straight down 0.8 in another cell: |0 - (-0.8)| <= 1, V = [-1.3, -0.3] only.
-  map.insertReading({-2.5, 3.5, 0}, {-2.5, 3.5, -0.8}, true);
+  map.insertReading({-2.5, 3.5, 0}, {-2.5, 3.5, -0.8}, ReadingKind::kObstacle);
   cell = map.cellVolumes({-3, 3});
   ASSERT_EQ(cell.positive.size(), 1u);
   EXPECT_TRUE(volumeIs(cell.positive[0], -1.3, -0.3, 1.0));
@@ -150,7 +151,8 @@ TEST(Insertion, VerticalRays) {
 TEST(Insertion, HorizontalRayMakesUnitVolumesAroundItsHeight) {
   // A horizontal ray crosses every cell at one height z: eq. (6) gives [z - 0.5, z + 0.5].
   Map map(MapConfig{0.5, 1000.0});
-  map.insertReading({0.1, 0.1, 1.0}, {2.1, 0.1, 1.0}, true);  // grid: x 0.2 -> 4.2, z = 2
+  map.insertReading({0.1, 0.1, 1.0}, {2.1, 0.1, 1.0},
+                    ReadingKind::kObstacle);  // grid: x 0.2 -> 4.2, z = 2
   for (int i = 0; i < 4; ++i) {
     const CellVolumes cell = map.cellVolumes({i, 0});
     ASSERT_EQ(cell.negative.size(), 1u) << "cell " << i;
@@ -166,26 +168,30 @@ TEST(Insertion, HorizontalRayMakesUnitVolumesAroundItsHeight) {
 
 TEST(Insertion, ReadingsMergeAndConserveMass) {
   Map map(unitConfig());
-  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 2}, false);  // eq. (4): [0, 2], mass 2
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 2},
+                    ReadingKind::kOutOfRange);  // eq. (4): [0, 2], mass 2
   EXPECT_DOUBLE_EQ(totalMass(map), 2.0);
-  map.insertReading({0.5, 0.5, 2.5}, {0.5, 0.5, 4.5}, false);  // [2.5, 4.5], gap 0.5
+  map.insertReading({0.5, 0.5, 2.5}, {0.5, 0.5, 4.5},
+                    ReadingKind::kOutOfRange);  // [2.5, 4.5], gap 0.5
   // Eq. (8): [0, 4.5], mass 2 + 0.5 + 2 = 4.5.
   CellVolumes cell = map.cellVolumes({0, 0});
   ASSERT_EQ(cell.negative.size(), 1u);
   EXPECT_TRUE(volumeIs(cell.negative[0], 0.0, 4.5, 4.5));
   EXPECT_DOUBLE_EQ(totalMass(map), 4.5);
-  map.insertReading({0.5, 0.5, 1}, {0.5, 0.5, 3}, false);  // [1, 3] inside: eq. (7), mass + 2
+  map.insertReading({0.5, 0.5, 1}, {0.5, 0.5, 3},
+                    ReadingKind::kOutOfRange);  // [1, 3] inside: eq. (7), mass + 2
   cell = map.cellVolumes({0, 0});
   ASSERT_EQ(cell.negative.size(), 1u);
   EXPECT_TRUE(volumeIs(cell.negative[0], 0.0, 4.5, 6.5));
   EXPECT_DOUBLE_EQ(totalMass(map), 6.5);
-  map.insertReading({0.5, 0.5, 6}, {0.5, 0.5, 7}, false);  // gap 1.5: a second volume
+  map.insertReading({0.5, 0.5, 6}, {0.5, 0.5, 7},
+                    ReadingKind::kOutOfRange);  // gap 1.5: a second volume
   EXPECT_EQ(map.cellVolumes({0, 0}).negative.size(), 2u);
   EXPECT_DOUBLE_EQ(totalMass(map), 7.5);
   // Two hits 0.8 apart: [2.5, 3.5] and [4.3, 5.3] merge through the gap of 0.8:
   // [2.5, 5.3], mass 1 + 0.8 + 1 = 2.8.
-  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 3}, true);
-  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 4.8}, true);
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 3}, ReadingKind::kObstacle);
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 4.8}, ReadingKind::kObstacle);
   cell = map.cellVolumes({0, 0});
   ASSERT_EQ(cell.positive.size(), 1u);
   EXPECT_TRUE(volumeIs(cell.positive[0], 2.5, 5.3, 2.8));
@@ -202,7 +208,11 @@ TEST(Insertion, RandomReadingsKeepTheInvariants) {
   for (int k = 0; k < 4000; ++k) {
     const Eigen::Vector3d origin = test::randomPoint(rng, 20.0, 3.0);
     const Eigen::Vector3d end = test::randomPoint(rng, 20.0, 3.0);
-    ASSERT_EQ(map.insertReading(origin, end, is_obstacle(rng)).inserted(), 1u);
+    ASSERT_EQ(
+        map.insertReading(origin, end,
+                          is_obstacle(rng) ? ReadingKind::kObstacle : ReadingKind::kOutOfRange)
+            .inserted(),
+        1u);
     const double total = totalMass(map);
     ASSERT_GE(total, previous_total + 1.0 - 1e-6 * total) << "after reading " << k;
     previous_total = total;
@@ -221,7 +231,8 @@ TEST(Insertion, MaxRangeTurnsFarHitsIntoFreeSpace) {
   InsertionConfig config;
   config.max_range = 4.0;
   // A hit 10 away along +x is cut at 4: free space over x in [0.5, 4.5], no obstacle.
-  const InsertionResult result = map.insertReading({0.5, 0.5, 0.5}, {10.5, 0.5, 0.5}, true, config);
+  const InsertionResult result =
+      map.insertReading({0.5, 0.5, 0.5}, {10.5, 0.5, 0.5}, ReadingKind::kObstacle, config);
   EXPECT_EQ(result.obstacle_readings, 0u);
   EXPECT_EQ(result.out_of_range_readings, 1u);
   EXPECT_EQ(result.truncated_to_max_range, 1u);
@@ -235,13 +246,13 @@ TEST(Insertion, MaxRangeTurnsFarHitsIntoFreeSpace) {
   EXPECT_EQ(map.bounds().max.x, 4);
   // An out-of-range reading is cut too, and is not counted as a truncated hit.
   const InsertionResult free_result =
-      map.insertReading({0.5, 0.5, 0.5}, {-9.5, 0.5, 0.5}, false, config);
+      map.insertReading({0.5, 0.5, 0.5}, {-9.5, 0.5, 0.5}, ReadingKind::kOutOfRange, config);
   EXPECT_EQ(free_result.out_of_range_readings, 1u);
   EXPECT_EQ(free_result.truncated_to_max_range, 0u);
   EXPECT_EQ(map.bounds().min.x, -4);
   // A hit at exactly max_range stays an obstacle.
   const InsertionResult at_range =
-      map.insertReading({0.5, 0.5, 0.5}, {0.5, 4.5, 0.5}, true, config);
+      map.insertReading({0.5, 0.5, 0.5}, {0.5, 4.5, 0.5}, ReadingKind::kObstacle, config);
   EXPECT_EQ(at_range.obstacle_readings, 1u);
   EXPECT_EQ(map.cellVolumes({0, 4}).positive.size(), 1u);
 }
@@ -250,15 +261,16 @@ TEST(Insertion, MinRangeDropsNearHitsOnly) {
   Map map(unitConfig());
   InsertionConfig config;
   config.min_range = 3.0;
-  InsertionResult result = map.insertReading({0.5, 0.5, 0}, {2.5, 0.5, 0}, true, config);
+  InsertionResult result =
+      map.insertReading({0.5, 0.5, 0}, {2.5, 0.5, 0}, ReadingKind::kObstacle, config);
   EXPECT_EQ(result.rejected_too_close, 1u);
   EXPECT_EQ(result.inserted(), 0u);
   EXPECT_TRUE(map.empty());
   // Out-of-range readings carry free space whatever their length.
-  result = map.insertReading({0.5, 0.5, 0}, {2.5, 0.5, 0}, false, config);
+  result = map.insertReading({0.5, 0.5, 0}, {2.5, 0.5, 0}, ReadingKind::kOutOfRange, config);
   EXPECT_EQ(result.out_of_range_readings, 1u);
   // A hit at exactly min_range is kept.
-  result = map.insertReading({0.5, 0.5, 0}, {0.5, 3.5, 0}, true, config);
+  result = map.insertReading({0.5, 0.5, 0}, {0.5, 3.5, 0}, ReadingKind::kObstacle, config);
   EXPECT_EQ(result.obstacle_readings, 1u);
   EXPECT_EQ(map.cellVolumes({0, 3}).positive.size(), 1u);
 }
@@ -268,15 +280,17 @@ TEST(Insertion, OutOfRangeReadingsCanBeIgnored) {
   InsertionConfig config;
   config.insert_out_of_range = false;
   config.max_range = 5.0;
-  EXPECT_EQ(map.insertReading({0.5, 0.5, 0}, {3.5, 0.5, 0}, false, config).ignored_out_of_range,
+  EXPECT_EQ(map.insertReading({0.5, 0.5, 0}, {3.5, 0.5, 0}, ReadingKind::kOutOfRange, config)
+                .ignored_out_of_range,
             1u);
   // A hit beyond max_range becomes an out-of-range reading, and is ignored too.
-  const InsertionResult far = map.insertReading({0.5, 0.5, 0}, {9.5, 0.5, 0}, true, config);
+  const InsertionResult far =
+      map.insertReading({0.5, 0.5, 0}, {9.5, 0.5, 0}, ReadingKind::kObstacle, config);
   EXPECT_EQ(far.ignored_out_of_range, 1u);
   EXPECT_EQ(far.inserted(), 0u);
   EXPECT_TRUE(map.empty());
   // Hits in range still bring their free space.
-  map.insertReading({0.5, 0.5, 0}, {3.5, 0.5, 0}, true, config);
+  map.insertReading({0.5, 0.5, 0}, {3.5, 0.5, 0}, ReadingKind::kObstacle, config);
   EXPECT_EQ(map.cellVolumes({1, 0}).negative.size(), 1u);
   EXPECT_EQ(map.cellVolumes({3, 0}).positive.size(), 1u);
 }
@@ -286,11 +300,12 @@ TEST(Insertion, WithoutNegativeSpaceOnlyObstaclesAreStored) {
   InsertionConfig config;
   config.model_negative_space = false;
   const InsertionResult free_result =
-      map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, false, config);
+      map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, ReadingKind::kOutOfRange, config);
   EXPECT_EQ(free_result.out_of_range_readings, 1u);
   EXPECT_TRUE(allVolumes(map).empty());
   EXPECT_TRUE(map.empty());  // bounds() holds cells with volumes only
-  map.insertReading({0.5, 0.5, 0}, {0.5, 5.5, 9}, true, config);  // would need padding too
+  map.insertReading({0.5, 0.5, 0}, {0.5, 5.5, 9}, ReadingKind::kObstacle,
+                    config);  // would need padding too
   const std::vector<test::VolumeRecord> volumes = allVolumes(map);
   ASSERT_EQ(volumes.size(), 1u);
   EXPECT_EQ(volumes[0], (test::VolumeRecord{0, 5, 0, 8.5f, 9.5f, 1.0f}));
@@ -302,7 +317,7 @@ TEST(Insertion, BoundsHoldOnlyCellsWithVolumes) {
   // A ray starting on the wall it leaves through never crosses its start cell: the start cell
   // gets no volume, and bounds() must not include it.
   Map map(unitConfig());
-  map.insertReading({2.0, 0.5, 0}, {-0.5, 0.5, 0}, false);
+  map.insertReading({2.0, 0.5, 0}, {-0.5, 0.5, 0}, ReadingKind::kOutOfRange);
   EXPECT_TRUE(map.cellVolumes({2, 0}).negative.empty());
   EXPECT_EQ(map.bounds().min, (CellIndex{-1, 0}));
   EXPECT_EQ(map.bounds().max, (CellIndex{1, 0}));
@@ -328,7 +343,7 @@ TEST(Insertion, ResultCountsEveryReadingOnce) {
                {150, 0, 0},                                   // beyond max_coordinate
                {0.6f, 0.5f, 0}, {0.5f, 0.5f, 0},              // too close (one of zero length)
                {30, 0, 0}};                                   // truncated to max_range
-  scan.free_endpoints = {{10, 10, 0}, {-10, 3, 2}, {0, 0, -kInf}, {0, -101, 0}, {0.5f, 0.5f, 0}};
+  scan.out_of_range = {{10, 10, 0}, {-10, 3, 2}, {0, 0, -kInf}, {0, -101, 0}, {0.5f, 0.5f, 0}};
   const InsertionResult result = map.insertScan(scan, config);
   EXPECT_EQ(result.obstacle_readings, 3u);
   EXPECT_EQ(result.out_of_range_readings, 3u);  // two free endpoints and the truncated hit
@@ -337,7 +352,7 @@ TEST(Insertion, ResultCountsEveryReadingOnce) {
   EXPECT_EQ(result.rejected_out_of_bounds, 2u);
   EXPECT_EQ(result.rejected_too_close, 3u);
   EXPECT_EQ(result.ignored_out_of_range, 0u);
-  EXPECT_EQ(result.inserted() + result.rejected(), scan.hits.size() + scan.free_endpoints.size());
+  EXPECT_EQ(result.inserted() + result.rejected(), scan.hits.size() + scan.out_of_range.size());
 
   config.insert_out_of_range = false;
   const InsertionResult ignoring = map.insertScan(scan, config);
@@ -345,8 +360,7 @@ TEST(Insertion, ResultCountsEveryReadingOnce) {
   EXPECT_EQ(ignoring.out_of_range_readings, 0u);
   EXPECT_EQ(ignoring.truncated_to_max_range, 0u);
   EXPECT_EQ(ignoring.ignored_out_of_range, 3u);
-  EXPECT_EQ(ignoring.inserted() + ignoring.rejected(),
-            scan.hits.size() + scan.free_endpoints.size());
+  EXPECT_EQ(ignoring.inserted() + ignoring.rejected(), scan.hits.size() + scan.out_of_range.size());
 
   InsertionResult sum = result;
   sum += ignoring;
@@ -376,10 +390,12 @@ TEST(Insertion, ScanEqualsReadingByReading) {
     const InsertionResult scan_result = by_scan.insertScan(scan, config);
     InsertionResult reading_result;
     for (const Eigen::Vector3f& hit : scan.hits) {
-      reading_result += by_reading.insertReading(origin, hit.cast<double>(), true, config);
+      reading_result +=
+          by_reading.insertReading(origin, hit.cast<double>(), ReadingKind::kObstacle, config);
     }
-    for (const Eigen::Vector3f& end : scan.free_endpoints) {
-      reading_result += by_reading.insertReading(origin, end.cast<double>(), false, config);
+    for (const Eigen::Vector3f& end : scan.out_of_range) {
+      reading_result +=
+          by_reading.insertReading(origin, end.cast<double>(), ReadingKind::kOutOfRange, config);
     }
     EXPECT_EQ(scan_result.obstacle_readings, reading_result.obstacle_readings);
     EXPECT_EQ(scan_result.out_of_range_readings, reading_result.out_of_range_readings);
@@ -430,7 +446,8 @@ TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
     const double length = length_in_eighths(rng) / 8.0;
     const double z1 = upwards(rng) ? z0 + length : z0 - length;
     const bool obstacle = is_obstacle(rng);
-    map.insertReading({x, y, z0}, {x, y, z1}, obstacle);
+    map.insertReading({x, y, z0}, {x, y, z1},
+                      obstacle ? ReadingKind::kObstacle : ReadingKind::kOutOfRange);
     const auto start_z = static_cast<float>(z0);
     const auto end_z = static_cast<float>(z1);
     if (obstacle) {
@@ -481,18 +498,17 @@ TEST(Insertion, SplitScanPiecesInsertedInOrderBuildTheSameMap) {
   const std::vector<Scan> pieces = splitScan(scan, 700);
   ASSERT_EQ(pieces.size(), 5u);
   std::vector<Eigen::Vector3f> hits;
-  std::vector<Eigen::Vector3f> free_endpoints;
+  std::vector<Eigen::Vector3f> out_of_range;
   for (const Scan& piece : pieces) {
     EXPECT_EQ(piece.origin, scan.origin);
-    EXPECT_LE(piece.hits.size() + piece.free_endpoints.size(), 700u);
+    EXPECT_LE(piece.hits.size() + piece.out_of_range.size(), 700u);
     hits.insert(hits.end(), piece.hits.begin(), piece.hits.end());
-    free_endpoints.insert(free_endpoints.end(), piece.free_endpoints.begin(),
-                          piece.free_endpoints.end());
+    out_of_range.insert(out_of_range.end(), piece.out_of_range.begin(), piece.out_of_range.end());
   }
   EXPECT_EQ(pieces[2].hits.size(), 600u);
-  EXPECT_EQ(pieces[2].free_endpoints.size(), 100u);
+  EXPECT_EQ(pieces[2].out_of_range.size(), 100u);
   EXPECT_EQ(hits, scan.hits);
-  EXPECT_EQ(free_endpoints, scan.free_endpoints);
+  EXPECT_EQ(out_of_range, scan.out_of_range);
 
   Map whole(map_config);
   Map piece_by_piece(map_config);
@@ -510,11 +526,11 @@ TEST(Insertion, SplitScanPiecesInsertedInOrderBuildTheSameMap) {
 TEST(Insertion, SplitScanEdgeCases) {
   EXPECT_TRUE(splitScan(Scan{}, 10).empty());
   Scan scan;
-  scan.free_endpoints.assign(3, Eigen::Vector3f(1, 2, 3));
+  scan.out_of_range.assign(3, Eigen::Vector3f(1, 2, 3));
   const std::vector<Scan> pieces = splitScan(scan, 1);
   ASSERT_EQ(pieces.size(), 3u);
   EXPECT_TRUE(pieces[0].hits.empty());
-  EXPECT_EQ(pieces[0].free_endpoints.size(), 1u);
+  EXPECT_EQ(pieces[0].out_of_range.size(), 1u);
   EXPECT_THROW(splitScan(scan, 0), ConfigError);
 }
 
@@ -535,7 +551,7 @@ TEST(Insertion, ThreadsBuildTheSameMap) {
     for (int threads = 1; threads <= 4; ++threads) {
       Map map(map_config);
       InsertionConfig config;
-      config.num_threads = threads;
+      config.insertion_threads = threads;
       config.clear_conflicting_free_space = clear_conflicts;
       for (const Scan& scan : scans) map.insertScan(scan, config);
       if (threads == 1) {
@@ -561,7 +577,7 @@ TEST(Insertion, ConflictingFreeSpaceOfTheSameScanIsDropped) {
   scan.origin = {0.5, 0.5, 0.5};
   scan.hits.push_back({5.5f, 0.5f, 0.5f});  // A: positive [0, 1] in cell (5, 0)
   scan.hits.push_back({8.5f, 0.5f, 0.5f});  // B: crosses cell (5, 0) at z = 0.5: [0, 1] there
-  scan.free_endpoints.push_back({9.5f, 0.5f, 9.5f});  // C: crosses cell (5, 0) at z in [5, 6]
+  scan.out_of_range.push_back({9.5f, 0.5f, 9.5f});  // C: crosses cell (5, 0) at z in [5, 6]
   for (bool clear_conflicts : {false, true}) {
     SCOPED_TRACE(clear_conflicts ? "clearing" : "not clearing");
     Map map(unitConfig());

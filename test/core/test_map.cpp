@@ -97,9 +97,11 @@ TEST(Decay, NewReadingsWeighMoreThanOldOnes) {
   // in between (s = 1). Vertical hit: V = [4.5, 5.5] mass 1, V' = [0, 4.5] mass 4.5.
   Map decayed(unitConfig());
   Map kept(unitConfig());
-  for (Map* map : {&decayed, &kept}) map->insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, true);
+  for (Map* map : {&decayed, &kept})
+    map->insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, ReadingKind::kObstacle);
   decayed.decay(0.5);
-  for (Map* map : {&decayed, &kept}) map->insertReading({0.5, 0.5, 0}, {0.5, 0.5, 6}, false);
+  for (Map* map : {&decayed, &kept})
+    map->insertReading({0.5, 0.5, 0}, {0.5, 0.5, 6}, ReadingKind::kOutOfRange);
   // Decayed: V mass 0.5; free [0, 6] = 0.5 * 4.5 + 6 = 8.25, rho- = 1.375;
   // p(5) = 0.5 / (0.5 + 1.375) = 0.2667. Kept: p(5) = 1 / (1 + 10.5 / 6) = 0.3636.
   const CellVolumes cell = decayed.cellVolumes({0, 0});
@@ -120,11 +122,11 @@ TEST(Decay, LongDecayedReadingsGiveWayToNewOnes) {
   // After 500 halvings the old obstacle weighs 2^-500 of a new reading: one free reading makes
   // the point free, and the map stays valid.
   Map map(unitConfig());
-  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, true);
-  map.insertReading({3.5, 0.5, 0}, {3.5, 0.5, 5}, true);  // untouched below
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, ReadingKind::kObstacle);
+  map.insertReading({3.5, 0.5, 0}, {3.5, 0.5, 5}, ReadingKind::kObstacle);  // untouched below
   const PointOccupancy untouched = map.occupancy({3.5, 0.5, 5.0});
   for (int step = 0; step < 500; ++step) map.decay(0.5);
-  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 6}, false);
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 6}, ReadingKind::kOutOfRange);
   const PointOccupancy p = map.occupancy({0.5, 0.5, 5.0});
   ASSERT_TRUE(p.known());
   EXPECT_LT(*p.probability, 1e-6f);
@@ -132,7 +134,7 @@ TEST(Decay, LongDecayedReadingsGiveWayToNewOnes) {
   EXPECT_EQ(map.occupancy({3.5, 0.5, 5.0}).probability, untouched.probability);
   EXPECT_TRUE(test::mapSatisfiesConstraints(map));
   // Fresh readings get the masses of fresh readings.
-  map.insertReading({-5.5, 0.5, 0}, {-5.5, 0.5, 5}, true);
+  map.insertReading({-5.5, 0.5, 0}, {-5.5, 0.5, 5}, ReadingKind::kObstacle);
   const CellVolumes fresh = map.cellVolumes({-6, 0});
   ASSERT_EQ(fresh.positive.size(), 1u);
   EXPECT_TRUE(test::volumeIs(fresh.positive[0], 4.5, 5.5, 1.0));
@@ -146,10 +148,10 @@ TEST(Decay, SurvivesDecayBeyondAnyExponentRange) {
   const std::vector<std::uint32_t> before = probe(map);
   constexpr double kTiny = std::numeric_limits<double>::denorm_min();
   for (int step = 0; step < 10000; ++step) map.decay(kTiny);
-  map.insertReading({30.5, 0.5, 0}, {30.5, 0.5, 1}, true);
+  map.insertReading({30.5, 0.5, 0}, {30.5, 0.5, 1}, ReadingKind::kObstacle);
   for (int step = 0; step < 10000; ++step) map.decay(kTiny);
   EXPECT_TRUE(test::sameProbabilities(probe(map), before));
-  map.insertReading({30.5, 0.5, 0}, {30.5, 0.5, 1}, true);
+  map.insertReading({30.5, 0.5, 0}, {30.5, 0.5, 1}, ReadingKind::kObstacle);
   const CellVolumes cell = map.cellVolumes(map.cellAtPoint(30.5, 0.5));
   // s = 5: V = [4.5, 5.5] and V' = [0, 4.5] in grid units; the first reading's masses, decayed
   // by 2^-(2^23.4) since, vanished in the merge.
@@ -179,7 +181,7 @@ TEST(Decay, RefusesFactorsOutsideZeroOne) {
 
 TEST(Map, GrowsInAllFourDirections) {
   Map map(unitConfig());
-  map.insertReading({0.5, 0.5, 0}, {3.5, 2.5, 1}, true);
+  map.insertReading({0.5, 0.5, 0}, {3.5, 2.5, 1}, ReadingKind::kObstacle);
   const std::vector<test::VolumeRecord> first = allVolumes(map);
   EXPECT_EQ(map.bounds().min, (CellIndex{0, 0}));
   EXPECT_EQ(map.bounds().max, (CellIndex{3, 2}));
@@ -191,7 +193,7 @@ TEST(Map, GrowsInAllFourDirections) {
       {{2.5, 900.5, 0}, {{-701, 0}, {500, 900}}},
       {{1.5, -300.5, 0}, {{-701, -301}, {500, 900}}}};
   for (const auto& [end, bounds] : far) {
-    map.insertReading(end + Eigen::Vector3d(0.2, 0.2, 0), end, true);
+    map.insertReading(end + Eigen::Vector3d(0.2, 0.2, 0), end, ReadingKind::kObstacle);
     EXPECT_EQ(map.bounds().min, bounds.min);
     EXPECT_EQ(map.bounds().max, bounds.max);
     EXPECT_EQ(map.cellVolumes(map.cellAtPoint(end.x(), end.y())).positive.size(), 1u);
@@ -208,48 +210,49 @@ TEST(Map, GrowsInAllFourDirections) {
 
 TEST(Map, RejectsReadingsBeyondMaxCoordinate) {
   Map map(unitConfig(100.0));
-  map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, true);
+  map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, ReadingKind::kObstacle);
   const std::vector<test::VolumeRecord> before = allVolumes(map);
   const std::uint64_t revision = map.revision();
   const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> far{
       {{0, 0, 0}, {150, 0, 0}}, {{0, 0, 0}, {0, -100.5, 0}}, {{0, 0, 0}, {0, 0, 1000}},
       {{101, 0, 0}, {0, 0, 0}}, {{0, 0, -200}, {1, 1, 1}},   {{1e30, 0, 0}, {0, 0, 0}}};
   for (const auto& [origin, end] : far) {
-    for (bool is_obstacle : {true, false}) {
-      const InsertionResult result = map.insertReading(origin, end, is_obstacle);
+    for (ReadingKind kind : {ReadingKind::kObstacle, ReadingKind::kOutOfRange}) {
+      const InsertionResult result = map.insertReading(origin, end, kind);
       EXPECT_EQ(result.rejected_out_of_bounds, 1u);
       EXPECT_EQ(result.inserted(), 0u);
     }
   }
   Scan scan;
   scan.hits = {{150, 0, 0}, {0, 0, -150}};
-  scan.free_endpoints = {{-150, 0, 0}};
+  scan.out_of_range = {{-150, 0, 0}};
   EXPECT_EQ(map.insertScan(scan).rejected_out_of_bounds, 3u);
   EXPECT_TRUE(test::sameVolumes(allVolumes(map), before));
   EXPECT_EQ(map.revision(), revision);
   EXPECT_EQ(map.bounds().max, (CellIndex{5, 0}));
   // Exactly at max_coordinate is still inside.
-  EXPECT_EQ(map.insertReading({0, 0, 0}, {100, 0, 0}, true).obstacle_readings, 1u);
+  EXPECT_EQ(map.insertReading({0, 0, 0}, {100, 0, 0}, ReadingKind::kObstacle).obstacle_readings,
+            1u);
   EXPECT_EQ(map.bounds().max, (CellIndex{100, 0}));
 }
 
 TEST(Map, RejectsNonFiniteReadings) {
   Map map(unitConfig());
-  map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, true);
+  map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, ReadingKind::kObstacle);
   const std::vector<test::VolumeRecord> before = allVolumes(map);
   const std::uint64_t revision = map.revision();
   const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> bad{
       {{kNaN, 0, 0}, {1, 1, 1}}, {{0, kInf, 0}, {1, 1, 1}},  {{0, 0, -kInf}, {1, 1, 1}},
       {{0, 0, 0}, {kNaN, 1, 1}}, {{0, 0, 0}, {1, -kInf, 1}}, {{0, 0, 0}, {1, 1, kNaN}}};
   for (const auto& [origin, end] : bad) {
-    for (bool is_obstacle : {true, false}) {
-      EXPECT_EQ(map.insertReading(origin, end, is_obstacle).rejected_non_finite, 1u);
+    for (ReadingKind kind : {ReadingKind::kObstacle, ReadingKind::kOutOfRange}) {
+      EXPECT_EQ(map.insertReading(origin, end, kind).rejected_non_finite, 1u);
     }
   }
   Scan scan;
   scan.origin = {kNaN, 0, 0};
   scan.hits = {{1, 1, 1}};
-  scan.free_endpoints = {{2, 2, 2}};
+  scan.out_of_range = {{2, 2, 2}};
   EXPECT_EQ(map.insertScan(scan).rejected_non_finite, 2u);
   EXPECT_TRUE(test::sameVolumes(allVolumes(map), before));
   EXPECT_EQ(map.revision(), revision);
@@ -266,7 +269,7 @@ TEST(Map, ClearEmptiesTheMapAndResetsDecay) {
   const MemoryUsage usage = map.memoryUsage();
   EXPECT_EQ(usage.positive_volumes + usage.negative_volumes, 0u);
   EXPECT_EQ(usage.table_one_bytes, 0u);
-  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, true);
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, ReadingKind::kObstacle);
   EXPECT_TRUE(test::volumeIs(map.cellVolumes({2, 2}).positive.at(0), 24.5, 25.5, 1.0));
 }
 
@@ -325,7 +328,7 @@ TEST(Map, SetCellVolumesOnADecayedMapKeepsTheGivenMasses) {
   EXPECT_FLOAT_EQ(cell.negative.at(0).mass, 0.25f);
   EXPECT_NEAR(map.occupancy({1.5, 2.5, 1.0}).positive_density, 1.5, 1e-6);
   // A new reading there merges at its own real mass: [0.5, 1.5] (mass 1) into [0, 2] (mass 3).
-  map.insertReading({1.5, 2.5, 1.0}, {1.6, 2.6, 1.0}, true);
+  map.insertReading({1.5, 2.5, 1.0}, {1.6, 2.6, 1.0}, ReadingKind::kObstacle);
   EXPECT_FLOAT_EQ(map.cellVolumes({1, 2}).positive.at(0).mass, 4.0f);
   // Masses beyond float range in the decayed unit are refused, the map unchanged.
   const float huge = std::numeric_limits<float>::max();
@@ -454,19 +457,23 @@ TEST(Config, InsertionConfigFieldsAreChecked) {
          c.max_range = 5.0;
        }),
        "min_range"},
-      {with([](InsertionConfig& c) { c.num_threads = 0; }), "num_threads"},
-      {with([](InsertionConfig& c) { c.num_threads = -2; }), "num_threads"},
-      {with([](InsertionConfig& c) { c.num_threads = 257; }), "num_threads"}};
+      {with([](InsertionConfig& c) { c.insertion_threads = 0; }), "insertion_threads"},
+      {with([](InsertionConfig& c) { c.insertion_threads = -2; }), "insertion_threads"},
+      {with([](InsertionConfig& c) { c.insertion_threads = 257; }), "insertion_threads"}};
   Map map(unitConfig());
   Scan scan;
   scan.hits = {{1, 1, 1}};
   for (const auto& [config, field] : bad) {
     expectConfigError([&] { config.validate(); }, field);
-    expectConfigError([&] { map.insertReading({0, 0, 0}, {1, 1, 1}, true, config); }, field);
+    expectConfigError(
+        [&] {
+          map.insertReading({0, 0, 0}, {1, 1, 1}, ReadingKind::kObstacle, config);
+        },
+        field);
     expectConfigError([&] { map.insertScan(scan, config); }, field);
   }
   EXPECT_TRUE(map.empty());
-  EXPECT_NO_THROW(with([](InsertionConfig& c) { c.num_threads = 256; }).validate());
+  EXPECT_NO_THROW(with([](InsertionConfig& c) { c.insertion_threads = 256; }).validate());
   EXPECT_NO_THROW(with([](InsertionConfig& c) { c.min_range = 1e9; }).validate());
 }
 
@@ -513,19 +520,19 @@ TEST(ChangeTracking, TileGeometry) {
 TEST(ChangeTracking, TilesTouchedByAnInsertionAreListed) {
   Map map(unitConfig());
   const std::uint64_t r0 = map.revision();
-  map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, true);  // tile (0, 0) only
+  map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, ReadingKind::kObstacle);  // tile (0, 0) only
   EXPECT_GT(map.revision(), r0);
   EXPECT_EQ(modifiedSince(map, r0), (std::vector<std::pair<int, int>>{{0, 0}}));
   const std::uint64_t r1 = map.revision();
   EXPECT_TRUE(modifiedSince(map, r1).empty());
-  map.insertReading({33.5, 0.5, 0}, {40.5, 0.5, 0}, false);  // tile (2, 0) only
+  map.insertReading({33.5, 0.5, 0}, {40.5, 0.5, 0}, ReadingKind::kOutOfRange);  // tile (2, 0) only
   EXPECT_EQ(modifiedSince(map, r1), (std::vector<std::pair<int, int>>{{2, 0}}));
   EXPECT_EQ(modifiedSince(map, r0), (std::vector<std::pair<int, int>>{{0, 0}, {2, 0}}));
   // Queries, rejected readings and readings that store nothing change nothing.
   const std::uint64_t r2 = map.revision();
   map.occupancy({1, 1, 1});
   map.memoryUsage();
-  map.insertReading({0, 0, 0}, {kNaN, 0, 0}, true);
+  map.insertReading({0, 0, 0}, {kNaN, 0, 0}, ReadingKind::kObstacle);
   EXPECT_EQ(map.revision(), r2);
   EXPECT_TRUE(modifiedSince(map, r2).empty());
   map.setCellVolumes({-20, 70}, CellVolumes{{{0, 1, 1}}, {}});
@@ -536,7 +543,7 @@ TEST(ChangeTracking, DecayIsAChangeOfNoTile) {
   // Decay changes every mass (what cellVolumes and serializeMap return), so the revision moves;
   // no probability changes, so no tile is listed. A factor of 1 changes nothing.
   Map map(unitConfig());
-  map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, true);
+  map.insertReading({0.5, 0.5, 0}, {5.5, 0.5, 0}, ReadingKind::kObstacle);
   const std::uint64_t r0 = map.revision();
   map.decay(1.0);
   EXPECT_EQ(map.revision(), r0);
@@ -554,11 +561,11 @@ TEST(ChangeTracking, ListsExactlyTheTilesWhoseCellsChanged) {
     const std::uint64_t revision = map.revision();
     if (k % 3 == 0) {
       InsertionConfig config;
-      config.num_threads = k % 2 == 0 ? 1 : 3;
+      config.insertion_threads = k % 2 == 0 ? 1 : 3;
       map.insertScan(test::randomScan(rng, test::randomPoint(rng, 40.0, 1.0), 6, 3, 60.0), config);
     } else {
       map.insertReading(test::randomPoint(rng, 60.0, 1.0), test::randomPoint(rng, 60.0, 1.0),
-                        k % 2 == 0);
+                        k % 2 == 0 ? ReadingKind::kObstacle : ReadingKind::kOutOfRange);
     }
     EXPECT_EQ(modifiedSince(map, revision), changedTiles(before, allVolumes(map)))
         << "insertion " << k;

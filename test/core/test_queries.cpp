@@ -117,7 +117,8 @@ TEST(Occupancy, DensitiesGrowWithRepeatedReadings) {
   // The same vertical hit three times (s = 1): V = [4.5, 5.5] and V' = [0, 4.5] each time, so
   // rho+ = 3 / 1 and rho- = 3 * 4.5 / 4.5 = 3.
   Map map(unitConfig());
-  for (int k = 0; k < 3; ++k) map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, true);
+  for (int k = 0; k < 3; ++k)
+    map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, ReadingKind::kObstacle);
   PointOccupancy p = map.occupancy({0.5, 0.5, 5.0});
   EXPECT_DOUBLE_EQ(p.positive_density, 3.0);
   EXPECT_DOUBLE_EQ(p.negative_density, 0.0);
@@ -128,7 +129,7 @@ TEST(Occupancy, DensitiesGrowWithRepeatedReadings) {
   EXPECT_FLOAT_EQ(p.probability.value(), 0.5f);
   // A free reading through the obstacle: rho- over [0, 6] is (13.5 + 6) / 6 = 3.25 where the
   // old free space was, and the obstacle's p drops to 3 / (3 + 3.25).
-  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 6}, false);
+  map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 6}, ReadingKind::kOutOfRange);
   p = map.occupancy({0.5, 0.5, 5.0});
   EXPECT_DOUBLE_EQ(p.negative_density, 3.25);
   EXPECT_FLOAT_EQ(p.probability.value(), static_cast<float>(3.0 / 6.25));

@@ -263,8 +263,8 @@ TEST(WalkRay, LongRay) {
 TEST(Insertion, ZeroLengthReadingsAreDroppedAsTooClose) {
   Map map(test::unitConfig());
   const Eigen::Vector3d p(1.5, -2.5, 0.5);
-  for (bool is_obstacle : {true, false}) {
-    const InsertionResult result = map.insertReading(p, p, is_obstacle);
+  for (ReadingKind kind : {ReadingKind::kObstacle, ReadingKind::kOutOfRange}) {
+    const InsertionResult result = map.insertReading(p, p, kind);
     EXPECT_EQ(result.rejected_too_close, 1u);
     EXPECT_EQ(result.inserted(), 0u);
   }

@@ -202,7 +202,7 @@ inline Scan randomScan(std::mt19937& rng, const Eigen::Vector3d& origin, std::si
     return p.cast<float>().eval();
   };
   for (std::size_t k = 0; k < num_hits; ++k) scan.hits.push_back(point());
-  for (std::size_t k = 0; k < num_free; ++k) scan.free_endpoints.push_back(point());
+  for (std::size_t k = 0; k < num_free; ++k) scan.out_of_range.push_back(point());
   return scan;
 }
 

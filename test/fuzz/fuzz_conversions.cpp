@@ -149,14 +149,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const sensor_msgs::PointCloud2 cloud = takeCloud(in);
       readings = mvog_ros::cloudToReadings(cloud, pose, kMaxPoints);
       message_points = std::size_t{cloud.width} * cloud.height;
-      check(readings.free_endpoints.empty());
+      check(readings.out_of_range.empty());
       check(readings.hits.size() == message_points);
     } else {
       double max_free_range = 0.0;
       const sensor_msgs::LaserScan scan = takeScan(in, max_free_range);
       readings = mvog_ros::scanToReadings(scan, pose, max_free_range, kMaxPoints, skipped);
       message_points = scan.ranges.size();
-      check(readings.hits.size() + readings.free_endpoints.size() + skipped == message_points);
+      check(readings.hits.size() + readings.out_of_range.size() + skipped == message_points);
     }
   } catch (const mvog_ros::InvalidMessage& e) {
     check(std::strlen(e.what()) > 0);  // refused, saying why
@@ -165,7 +165,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   if (verbose()) {
     std::printf("  %zu hits, %zu free endpoints, %zu skipped\n", readings.hits.size(),
-                readings.free_endpoints.size(), skipped);
+                readings.out_of_range.size(), skipped);
   }
   check(message_points <= kMaxPoints);
   check(readings.origin.isApprox(pose.translation()));
@@ -178,10 +178,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   mvog::InsertionConfig insertion;
   insertion.clear_conflicting_free_space = (options & 2) != 0;
   insertion.model_negative_space = (options & 4) == 0;
-  insertion.num_threads = (options & 8) != 0 ? 2 : 1;
+  insertion.insertion_threads = (options & 8) != 0 ? 2 : 1;
   const mvog::InsertionResult result = map.insertScan(readings, insertion);
   check(result.inserted() + result.rejected() ==
-        readings.hits.size() + readings.free_endpoints.size());
+        readings.hits.size() + readings.out_of_range.size());
   const mvog::MemoryUsage usage = map.memoryUsage();
   check(result.inserted() > 0 || usage.cells_with_volumes == 0);
   if (verbose()) {

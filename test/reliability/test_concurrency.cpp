@@ -1,6 +1,6 @@
 // What mvog::Map promises about threads, checked under ThreadSanitizer by scripts/sanitizers.sh
 // (and under AddressSanitizer + UBSan there too):
-//  - insertScan with num_threads > 1 runs its own threads without data races, and builds the
+//  - insertScan with insertion_threads > 1 runs its own threads without data races, and builds the
 //    same map as one thread;
 //  - const methods may run concurrently with each other (many readers, no writer);
 //  - the server's pattern (src/ros/mapper.cpp): one writer (insertScan with threads, decay) under
@@ -52,7 +52,7 @@ mvog::Scan makeScan(std::uint32_t seed, std::size_t count, const Eigen::Vector3d
                                     std::sin(e));
     const Eigen::Vector3f end = (origin + range(random) * direction).cast<float>();
     if (k % 10 == 9) {
-      scan.free_endpoints.push_back(end);
+      scan.out_of_range.push_back(end);
     } else {
       scan.hits.push_back(end);
     }
@@ -60,9 +60,9 @@ mvog::Scan makeScan(std::uint32_t seed, std::size_t count, const Eigen::Vector3d
   return scan;
 }
 
-mvog::InsertionConfig threads(int num_threads) {
+mvog::InsertionConfig threads(int insertion_threads) {
   mvog::InsertionConfig config;
-  config.num_threads = num_threads;
+  config.insertion_threads = insertion_threads;
   config.max_range = 5.0;
   return config;
 }

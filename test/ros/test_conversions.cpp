@@ -56,7 +56,7 @@ TEST(ScanToReadings, ValidRangesAreHitsAlongTheirBeams) {
   std::size_t skipped = 99;
   const mvog::Scan readings = convert(fourBeamScan({1.0f, 2.0f, 0.5f, 10.0f}), kInf, skipped);
   EXPECT_EQ(skipped, 0u);
-  EXPECT_TRUE(readings.free_endpoints.empty());
+  EXPECT_TRUE(readings.out_of_range.empty());
   ASSERT_EQ(readings.hits.size(), 4u);
   expectNear(readings.hits[0], {1.0, 0.0, 0.0});
   expectNear(readings.hits[1], {0.0, 2.0, 0.0});
@@ -72,21 +72,21 @@ TEST(ScanToReadings, OutOfRangeBeamsAreFreeUpToRangeMaxOrTheMaximumFreeRange) {
   ASSERT_EQ(readings.hits.size(), 2u);
   expectNear(readings.hits[0], {-1.0, 0.0, 0.0});
   expectNear(readings.hits[1], {0.0, -5.0, 0.0});  // a hit beyond max_free_range stays a hit
-  ASSERT_EQ(readings.free_endpoints.size(), 2u);
-  expectNear(readings.free_endpoints[0], {10.0, 0.0, 0.0});  // +Inf: free up to range_max
-  expectNear(readings.free_endpoints[1], {0.0, 10.0, 0.0});  // beyond range_max: same
+  ASSERT_EQ(readings.out_of_range.size(), 2u);
+  expectNear(readings.out_of_range[0], {10.0, 0.0, 0.0});  // +Inf: free up to range_max
+  expectNear(readings.out_of_range[1], {0.0, 10.0, 0.0});  // beyond range_max: same
 
   readings = convert(scan, 4.0, skipped);  // ~max_range shorter than range_max
-  ASSERT_EQ(readings.free_endpoints.size(), 2u);
-  expectNear(readings.free_endpoints[0], {4.0, 0.0, 0.0});
-  expectNear(readings.free_endpoints[1], {0.0, 4.0, 0.0});
+  ASSERT_EQ(readings.out_of_range.size(), 2u);
+  expectNear(readings.out_of_range[0], {4.0, 0.0, 0.0});
+  expectNear(readings.out_of_range[1], {0.0, 4.0, 0.0});
 }
 
 TEST(ScanToReadings, NaNNegativeInfinityAndTooShortRangesAreSkippedAndCounted) {
   std::size_t skipped = 0;
   const mvog::Scan readings = convert(fourBeamScan({kNaN, -kInf, 0.4f, 3.0f}), kInf, skipped);
   EXPECT_EQ(skipped, 3u);
-  EXPECT_TRUE(readings.free_endpoints.empty());
+  EXPECT_TRUE(readings.out_of_range.empty());
   ASSERT_EQ(readings.hits.size(), 1u);
   expectNear(readings.hits[0], {0.0, -3.0, 0.0});
 }
@@ -99,8 +99,8 @@ TEST(ScanToReadings, AppliesTheSensorPoseAndStartsRaysAtTheSensor) {
   ASSERT_EQ(readings.hits.size(), 2u);
   expectNear(readings.hits[0], {1.0, 3.0, 3.0});   // sensor x = map y
   expectNear(readings.hits[1], {-1.0, 2.0, 3.0});  // sensor y = map -x
-  ASSERT_EQ(readings.free_endpoints.size(), 1u);
-  expectNear(readings.free_endpoints[0], {11.0, 2.0, 3.0});  // sensor -y = map x
+  ASSERT_EQ(readings.out_of_range.size(), 1u);
+  expectNear(readings.out_of_range[0], {11.0, 2.0, 3.0});  // sensor -y = map x
 }
 
 TEST(ScanToReadings, AcceptsOneBeamWithoutIncrement) {
@@ -222,7 +222,7 @@ std::vector<Eigen::Vector3d> samplePoints() {
 void expectPoints(const sensor_msgs::PointCloud2& cloud,
                   const std::vector<Eigen::Vector3d>& points) {
   const mvog::Scan readings = cloudToReadings(cloud, Eigen::Isometry3d::Identity(), kManyPoints);
-  EXPECT_TRUE(readings.free_endpoints.empty());
+  EXPECT_TRUE(readings.out_of_range.empty());
   ASSERT_EQ(readings.hits.size(), points.size());
   for (std::size_t k = 0; k < points.size(); ++k) expectNear(readings.hits[k], points[k]);
 }

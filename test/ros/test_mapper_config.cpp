@@ -53,7 +53,7 @@ TEST(MapperConfig, AcceptsSensibleNonDefaultValues) {
   config.map.resolution = 0.05;
   config.insertion.min_range = 0.3;
   config.insertion.max_range = 8.0;
-  config.insertion.num_threads = 4;
+  config.insertion.insertion_threads = 4;
   config.scan_topics = {"front/scan", "/rear/scan", "~scan"};
   config.cloud_topics = {"camera/depth/points"};
   config.tf_timeout = 0.0;
@@ -129,9 +129,9 @@ TEST(MapperConfig, RefusesOutOfRangeValues) {
          c.map.resolution = 0.001;
          c.map.max_coordinate = 10000.0;
        }},
-      {"insertion_threads", "0", [](MapperConfig& c) { c.insertion.num_threads = 0; }},
-      {"insertion_threads", "< 0", [](MapperConfig& c) { c.insertion.num_threads = -2; }},
-      {"insertion_threads", "1000", [](MapperConfig& c) { c.insertion.num_threads = 1000; }},
+      {"insertion_threads", "0", [](MapperConfig& c) { c.insertion.insertion_threads = 0; }},
+      {"insertion_threads", "< 0", [](MapperConfig& c) { c.insertion.insertion_threads = -2; }},
+      {"insertion_threads", "1000", [](MapperConfig& c) { c.insertion.insertion_threads = 1000; }},
       {"sensor_queue_size", "0", [](MapperConfig& c) { c.sensor_queue_size = 0; }},
       {"sensor_queue_size", "< 0", [](MapperConfig& c) { c.sensor_queue_size = -1; }},
       {"sensor_queue_size", "huge", [](MapperConfig& c) { c.sensor_queue_size = 1 << 30; }},

@@ -45,7 +45,7 @@ MvogRun runMvog(const InputData& input, const RunOptions& options) {
   map_config.resolution = options.resolution;
   mvog::InsertionConfig insertion;
   insertion.max_range = options.max_range;
-  insertion.num_threads = options.threads;
+  insertion.insertion_threads = options.threads;
   insertion.clear_conflicting_free_space = options.clear_conflicting_free_space;
   MvogRun run{mvog::Map(map_config), {}};
   MvogStats& stats = run.stats;

@@ -84,8 +84,8 @@ InputData loadBag(const std::string& path, const std::string& fixed_frame) {
         ++input.invalid_messages;
         continue;
       }
-      input.out_of_range_readings += readings.free_endpoints.size();
-      readings.free_endpoints.clear();
+      input.out_of_range_readings += readings.out_of_range.size();
+      readings.out_of_range.clear();
       const std::size_t before = readings.hits.size();
       readings.hits.erase(std::remove_if(readings.hits.begin(), readings.hits.end(),
                                          [](const Eigen::Vector3f& p) { return !p.allFinite(); }),

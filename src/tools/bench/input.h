@@ -20,7 +20,7 @@ class InputError : public std::runtime_error {
 /// Both backends see exactly these rays: each scan's origin and its obstacle readings (hits) in
 /// the map frame, single precision. Out-of-range readings are counted but disregarded, as in the
 /// paper's Table I ("Out-of-range sensor readings present in the experiments are disregarded in
-/// all four representations"), so `Scan::free_endpoints` is always empty.
+/// all four representations"), so `Scan::out_of_range` is always empty.
 struct InputData {
   std::string format;  ///< "bag" or "graph"
   std::vector<mvog::Scan> scans;
