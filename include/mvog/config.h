@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -12,6 +13,50 @@ class ConfigError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+/// How many times one scan's readings count at one height of a column.
+enum class MassCounting : std::uint8_t {
+  /// The paper (Sec. III-B.2): every reading adds its own volumes, each of density 1, so a
+  /// column that 200 rays of a scan cross gains 200 times the mass of a column one ray ends in.
+  kPerReading,
+  /// Each scan adds density 1 once over the union of the heights its readings saw in the column:
+  /// the readings of one scan share one pose and one instant, so they are not independent
+  /// observations of a column (OctoMap's insertPointCloud updates each voxel once per scan too).
+  kPerScan,
+};
+
+/// The rules of the model where it departs from the paper's text (the README's decisions table).
+/// ModelRules::paper() is the paper's exact model; the defaults are the measured best.
+struct ModelRules {
+  /// Sec. V.B: in each column, a scan's free space is clipped around the positive volumes of the
+  /// same scan (a reading never frees the space where another reading of its scan hit).
+  bool clip_free_space_at_hits = true;
+  /// See MassCounting.
+  MassCounting mass_counting = MassCounting::kPerScan;
+  /// Sec. V.C: negative volumes are split at the bottoms and tops of positive volumes, so that
+  /// the free space seen within an obstacle's heights keeps its own density in eq. (9) instead
+  /// of the average over the whole free column (which erases surfaces under dense free space).
+  bool split_free_space_at_obstacles = true;
+
+  /// The model exactly as the paper describes it.
+  static ModelRules paper() { return {false, MassCounting::kPerReading, false}; }
+  friend bool operator==(const ModelRules& a, const ModelRules& b) {
+    return a.clip_free_space_at_hits == b.clip_free_space_at_hits &&
+           a.mass_counting == b.mass_counting &&
+           a.split_free_space_at_obstacles == b.split_free_space_at_obstacles;
+  }
+};
+
+/// A point is occupied where eq. (9) gives p above a threshold (Sec. III-C); this is the default
+/// of the server's ~occupancy_threshold and of every tool. With MassCounting::kPerScan, p is the
+/// share of the scans that looked at a height and saw it hit. OctoMap's default sensor model
+/// (hit 0.7, miss 0.4) calls a voxel occupied once that share of its updates exceeds
+/// |logit(0.4)| / (logit(0.7) + |logit(0.4)|) = 0.324 (ignoring its clamping): the same rule. A
+/// surface that rays also cross at grazing angles reflects only a part of them, free space none,
+/// so occupancy does not need a majority of hits.
+constexpr double kDefaultOccupancyThreshold = 0.324;
+/// The paper's threshold (Fig. 4: "probability of occupancy greater than 0.5").
+constexpr double kPaperOccupancyThreshold = 0.5;
+
 /// The map itself.
 struct MapConfig {
   /// Edge of a square cell in metres; s = 1 / resolution (Sec. III-A).
@@ -19,6 +64,8 @@ struct MapConfig {
   /// Readings whose origin or end lies further than this from the map origin along any axis (m)
   /// are rejected, so that a wild point cannot make the map grow without bound (Sec. V.A).
   double max_coordinate = 10000.0;
+  /// How readings become volumes and how the lists are kept (saved with the map).
+  ModelRules rules;
 
   /// Throws ConfigError naming the first invalid field.
   void validate() const;
@@ -35,9 +82,6 @@ struct InsertionConfig {
   bool insert_out_of_range = true;
   /// Whether negative (free-space) volumes are created at all.
   bool model_negative_space = true;
-  /// Sec. V.B remedy: within one scan, a negative volume that overlaps a positive volume created
-  /// by the same scan in the same cell is not inserted.
-  bool clear_conflicting_free_space = false;
   /// Threads used by Map::insertScan; the resulting map is identical for any count.
   int insertion_threads = 1;
 

@@ -202,7 +202,7 @@ class Map {
   const Cell* findCell(const CellIndex& cell) const;
   const Tile* findTile(const TileIndex& index) const;
   std::vector<std::uint64_t> sortedTileKeys() const;
-  bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool is_obstacle,
+  bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, ReadingKind kind,
                      const InsertionConfig& config, Eigen::Vector3d& ray_end, bool& obstacle,
                      InsertionResult& result) const;
   template <class T, class CellValue>

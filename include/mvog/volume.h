@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
+#include <limits>
 #include <string>
 
 namespace mvog {
@@ -31,10 +31,17 @@ enum class VolumeSign : std::uint8_t { kPositive, kNegative };
 constexpr float kMinVolumeHeight = 1.0f;
 constexpr float kMaxMergeGap = 1.0f;
 
+/// Whether two volumes of one list, one above the other, must merge (Sec. III-A: they overlap,
+/// touch, or leave a gap of at most kMaxMergeGap). The one test every part of the model uses, in
+/// float arithmetic, so that what the merge produces the checks accept.
+inline bool mustMerge(float lower_top, float upper_bottom) {
+  return upper_bottom - lower_top <= kMaxMergeGap;
+}
+
 /// Eq. (6): the volume spanning [z_a, z_b] (either order) with the minimum height enforced around
-/// its centre. The mass is that of density 1 over the final height, times `unit_mass` (the map's
-/// stored-mass unit, see Map::decay): every new volume starts at density 1 (Sec. III-B.2).
-inline Volume makeVolume(float z_a, float z_b, float unit_mass) {
+/// its centre. Its mass is that of density 1 over its final height: every new volume starts at
+/// density 1 (Sec. III-B.2).
+inline Volume makeVolume(float z_a, float z_b) {
   Volume volume{std::min(z_a, z_b), std::max(z_a, z_b), 0.0f};
   if (volume.height() < kMinVolumeHeight) {
     const float centre = 0.5f * (volume.bottom + volume.top);  // eq. (6)
@@ -49,87 +56,25 @@ inline Volume makeVolume(float z_a, float z_b, float unit_mass) {
       if (volume.height() < kMinVolumeHeight) volume.top = std::nextafter(volume.top, INFINITY);
     }
   }
-  volume.mass = volume.height() * unit_mass;
+  volume.mass = volume.height();
   return volume;
-}
-
-/// The run list[first, last) of the volumes that `volume` merges with when it is inserted into
-/// the sorted list `list[0, count)` (which satisfies the Sec. III-A constraints): those whose gap
-/// to it is at most kMaxMergeGap (a gap <= 0 is an overlap, eq. 7; a gap in (0, 1] is "too close",
-/// eq. 8). The list's own gaps exceed 1, so they are consecutive. first == last where it merges
-/// with none: it then goes in at `first` and the list grows by one.
-struct MergeRun {
-  std::uint32_t first = 0;
-  std::uint32_t last = 0;
-  bool addsVolume() const { return first == last; }
-};
-
-inline MergeRun findMergeRun(const Volume* list, std::uint32_t count, const Volume& volume) {
-  MergeRun run;
-  if (count == 1) {
-    // The commonest column, one volume (free space above a floor, say): no scan.
-    if (volume.bottom - list[0].top > kMaxMergeGap) return {1, 1};
-    return {0, list[0].bottom - volume.top <= kMaxMergeGap ? 1u : 0u};
-  }
-  // Columns hold a handful of volumes: a linear scan beats a binary search there.
-  while (run.first != count && volume.bottom - list[run.first].top > kMaxMergeGap) ++run.first;
-  run.last = run.first;
-  while (run.last != count && list[run.last].bottom - volume.top <= kMaxMergeGap) ++run.last;
-  return run;
-}
-
-/// `volume` merged with the volumes [first, last) of a list that it overlaps or comes within
-/// kMaxMergeGap of: one volume spanning them all, with their summed mass (eq. 7) plus, for every
-/// gap filled, the gap's mass at density 1 (times `unit_mass`, eq. 8b).
-inline Volume mergedVolume(const Volume& volume, const Volume* first, const Volume* last,
-                           float unit_mass) {
-  Volume merged = volume;
-  float covered = volume.height();  // length of the union of the merged volumes
-  for (const Volume* v = first; v != last; ++v) {
-    const float overlap = std::min(v->top, volume.top) - std::max(v->bottom, volume.bottom);
-    covered += v->height() - std::max(0.0f, overlap);
-    merged.mass += v->mass;
-    merged.bottom = std::min(merged.bottom, v->bottom);
-    merged.top = std::max(merged.top, v->top);
-  }
-  merged.mass += std::max(0.0f, merged.height() - covered) * unit_mass;
-  return merged;
-}
-
-/// Inserts `volume` into `list[0, count)` at `run` (from findMergeRun on the same list) and
-/// restores the constraints: the volumes of the run are merged with it (mergedVolume).
-/// `list` must have room for count + 1 volumes when run.addsVolume(). Returns the new count.
-inline std::uint32_t insertVolumeAt(Volume* list, std::uint32_t count, const MergeRun& run,
-                                    const Volume& volume, float unit_mass) {
-  Volume* const first = list + run.first;
-  if (run.addsVolume()) {
-    std::memmove(first + 1, first, std::size_t{count - run.first} * sizeof(Volume));
-    *first = volume;
-    return count + 1;
-  }
-  if (run.last == run.first + 1) {
-    // The commonest merge, with one volume: the list keeps its length, nothing moves.
-    *first = mergedVolume(volume, first, first + 1, unit_mass);
-    return count;
-  }
-  *first = mergedVolume(volume, first, list + run.last, unit_mass);
-  std::memmove(first + 1, list + run.last, std::size_t{count - run.last} * sizeof(Volume));
-  return count - (run.last - run.first) + 1;
-}
-
-/// Inserts `volume` into the sorted list `list[0, count)` and restores the Sec. III-A
-/// constraints (findMergeRun, then insertVolumeAt). `list` must have room for count + 1
-/// volumes. Returns the new count.
-inline std::uint32_t insertVolume(Volume* list, std::uint32_t count, const Volume& volume,
-                                  float unit_mass) {
-  return insertVolumeAt(list, count, findMergeRun(list, count, volume), volume, unit_mass);
 }
 
 /// The volume of `list[0, count)` that contains height z, or nullptr.
 const Volume* findVolume(const Volume* list, std::uint32_t count, float z);
 
-/// Empty if `list[0, count)` satisfies Sec. III-A (sorted, heights >= 1, gaps > 1, finite
-/// non-negative masses), else what is wrong with it.
-std::string checkVolumeList(const Volume* list, std::size_t count);
+/// Eq. (9) from the densities of the positive and negative volumes holding a point (0 where
+/// none does): p = rho+ / (rho+ + rho-), or NaN where both are 0 (unknown).
+inline float occupancyProbability(float rho_plus, float rho_minus) {
+  const float sum = rho_plus + rho_minus;
+  return sum > 0.0f ? rho_plus / sum : std::numeric_limits<float>::quiet_NaN();
+}
+
+/// Empty if the two lists of a column satisfy Sec. III-A (each sorted, heights >= 1, gaps > 1,
+/// finite non-negative masses), else what is wrong with them. With
+/// `split_free_space_at_obstacles` (ModelRules), two negative volumes may also touch where a
+/// positive volume begins or ends.
+std::string checkColumn(const Volume* positive, std::size_t num_positive, const Volume* negative,
+                        std::size_t num_negative, bool split_free_space_at_obstacles);
 
 }  // namespace mvog

@@ -72,67 +72,6 @@ class Map::Cell {
   std::size_t bytes() const { return block_ == nullptr ? 0 : blockBytes(block_->capacity); }
   std::int32_t exponent() const { return block_ == nullptr ? 0 : block_->exponent; }
 
-  /// The common case of insert(), done in place: a negative volume that merges into the list of
-  /// a cell written since the last decay (no block to grow, no mass to rescale). Returns false,
-  /// changing nothing, in every other case.
-  bool mergeNegative(const Volume& volume, float unit_mass, std::int64_t unit_exponent) {
-    if (block_ == nullptr || block_->exponent != unit_exponent) return false;
-    Volume* const list = volumes() + block_->num_positive;
-    const MergeRun run = findMergeRun(list, block_->num_negative, volume);
-    if (run.addsVolume()) return false;
-    block_->num_negative = insertVolumeAt(list, block_->num_negative, run, volume, unit_mass);
-    return true;
-  }
-
-  /// Inserts `volume`, whose mass is in the unit of the map's current `unit_exponent`, with the
-  /// constraints applied; returns the change of bytes held. The cell's masses are first brought
-  /// to that unit (exactly, by a power of two, unless they underflow). The block grows only when
-  /// the list does (most insertions merge into a volume already there).
-  std::ptrdiff_t insert(VolumeSign sign, const Volume& volume, float unit_mass,
-                        std::int64_t unit_exponent) {
-    if (block_ == nullptr) {
-      const std::ptrdiff_t bytes_added = reserve(1);
-      block_->exponent = static_cast<std::int32_t>(unit_exponent);
-      (sign == VolumeSign::kPositive ? block_->num_positive : block_->num_negative) = 1;
-      volumes()[0] = volume;
-      return bytes_added;
-    }
-    const std::uint32_t total = block_->num_positive + block_->num_negative;
-    if (block_->exponent != unit_exponent) {
-      // Decay since the last write lowered the unit exponent: unit_exponent < exponent.
-      const auto shift = static_cast<int>(unit_exponent - block_->exponent);
-      Volume* all = volumes();
-      for (std::uint32_t k = 0; k < total; ++k) all[k].mass = std::ldexp(all[k].mass, shift);
-      block_->exponent = static_cast<std::int32_t>(unit_exponent);
-    }
-    const bool positive = sign == VolumeSign::kPositive;
-    const std::uint32_t offset = positive ? 0 : block_->num_positive;
-    const std::uint32_t count = positive ? block_->num_positive : block_->num_negative;
-    const MergeRun run = findMergeRun(volumes() + offset, count, volume);
-    std::ptrdiff_t bytes_added = 0;
-    if (run.addsVolume()) {
-      bytes_added = reserve(total + 1);
-      // The positive list grows into the negative list's place: move that one up first.
-      if (positive) {
-        std::memmove(volumes() + count + 1, volumes() + count,
-                     std::size_t{block_->num_negative} * sizeof(Volume));
-      }
-    }
-    const std::uint32_t new_count =
-        insertVolumeAt(volumes() + offset, count, run, volume, unit_mass);
-    if (positive) {
-      // A merge that shrank the positive list leaves a hole before the negative list.
-      if (new_count < count) {
-        std::memmove(volumes() + new_count, volumes() + count,
-                     std::size_t{block_->num_negative} * sizeof(Volume));
-      }
-      block_->num_positive = new_count;
-    } else {
-      block_->num_negative = new_count;
-    }
-    return bytes_added;
-  }
-
   /// Replaces both lists, masses in the unit of `unit_exponent`; returns the change of bytes held.
   std::ptrdiff_t assign(const CellVolumes& volumes_in, std::int64_t unit_exponent) {
     const std::size_t old_bytes = bytes();
@@ -302,93 +241,6 @@ void Map::recomputeBounds() {
   }
 }
 
-bool Map::acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool is_obstacle,
-                        const InsertionConfig& config, Eigen::Vector3d& ray_end, bool& obstacle,
-                        InsertionResult& result) const {
-  if (!origin.allFinite() || !end.allFinite()) {
-    ++result.rejected_non_finite;
-    return false;
-  }
-  if (origin.cwiseAbs().maxCoeff() > config_.max_coordinate ||
-      end.cwiseAbs().maxCoeff() > config_.max_coordinate) {
-    ++result.rejected_out_of_bounds;
-    return false;
-  }
-  const Eigen::Vector3d ray = end - origin;
-  const double length = ray.norm();
-  // A zero-length out-of-range reading carries no free space; a zero-length hit is below any
-  // min_range but the sensor itself (decision: both are dropped as too close).
-  if (length == 0.0 || (is_obstacle && length < config.min_range)) {
-    ++result.rejected_too_close;
-    return false;
-  }
-  obstacle = is_obstacle && length <= config.max_range;
-  if (!obstacle && !config.insert_out_of_range) {
-    ++result.ignored_out_of_range;
-    return false;
-  }
-  ray_end =
-      length > config.max_range ? Eigen::Vector3d(origin + ray * (config.max_range / length)) : end;
-  if (obstacle) {
-    ++result.obstacle_readings;
-  } else {
-    ++result.out_of_range_readings;
-    if (is_obstacle) ++result.truncated_to_max_range;
-  }
-  return true;
-}
-
-namespace {
-
-/// The positive volumes a scan creates, per cell, for the Sec. V.B remedy.
-using ScanPositives = std::unordered_map<std::uint64_t, std::vector<Volume>>;
-
-bool conflictsWithScan(const ScanPositives& positives, const CellIndex& cell,
-                       const Volume& negative) {
-  const auto it = positives.find(packKey(cell.x, cell.y));
-  if (it == positives.end()) return false;
-  return std::any_of(it->second.begin(), it->second.end(), [&](const Volume& positive) {
-    return positive.bottom < negative.top && negative.bottom < positive.top;
-  });
-}
-
-/// Sec. III-B.2: the volumes one reading creates, handed to emit(cell, sign, volume) in the
-/// order the paper creates them. `start` and `end` are in grid units.
-/// Only cells for which owns(cell) holds are emitted (see the threaded Map::insertScan).
-template <class Owns, class Emit>
-void volumesOfReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
-                      bool model_negative_space, float unit_mass,
-                      const ScanPositives* scan_positives, Owns&& owns, Emit&& emit) {
-  const float end_z = static_cast<float>(end.z());
-  auto obstacle_volume = [&] { return makeVolume(end_z - 0.5f, end_z + 0.5f, unit_mass); };
-  if (!model_negative_space) {
-    // Only the obstacle's own volume, in the cell the walk would end in (see walkRay): no walk.
-    const CellIndex cell = cellAt(end.x(), end.y());
-    if (obstacle && owns(cell)) emit(cell, VolumeSign::kPositive, obstacle_volume());
-    return;
-  }
-  auto emit_negative = [&](const CellIndex& cell, double z_a, double z_b) {
-    const Volume negative = makeVolume(static_cast<float>(z_a), static_cast<float>(z_b), unit_mass);
-    if (scan_positives == nullptr || !conflictsWithScan(*scan_positives, cell, negative)) {
-      emit(cell, VolumeSign::kNegative, negative);
-    }
-  };
-  walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
-          [&](const CellIndex& cell, double z_enter, double z_exit, bool is_last) {
-            if (!owns(cell)) return;
-            if (!is_last || !obstacle) {
-              emit_negative(cell, z_enter, z_exit);  // eqs. (3) and (4)
-              return;
-            }
-            const Volume positive = obstacle_volume();  // eq. (5)
-            emit(cell, VolumeSign::kPositive, positive);
-            if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
-              emit_negative(cell, z_enter, z_enter < end.z() ? positive.bottom : positive.top);
-            }
-          });
-}
-
-}  // namespace
 
 /// Finds or creates the tiles that a writer touches, remembering the last one: consecutive cells
 /// of a ray mostly share a tile. `created` (if given) receives new tiles instead of the map, so
@@ -409,28 +261,10 @@ class Map::TileWriter {
     }
     return last_tile_->at(index);
   }
-  void insert(const CellIndex& index, VolumeSign sign, const Volume& volume, float unit_mass) {
-    Cell& target = cell(index);
-    // Most volumes are free space merging into a volume already there: that case stays inline in
-    // the ray walk, everything else goes through Cell::insert.
-    if (sign == VolumeSign::kNegative &&
-        target.mergeNegative(volume, unit_mass, map_.unit_exponent_))
-      return;
-    insertAnyCase(target, index, sign, volume, unit_mass);
-  }
   std::ptrdiff_t bytesAdded() const { return bytes_added_; }
   const CellRange& touched() const { return touched_; }
 
  private:
-  // Out of line (GCC and Clang both read the attribute), so that the rare cases do not crowd the
-  // registers of the ray walk that inlines insert().
-  __attribute__((noinline)) void insertAnyCase(Cell& target, const CellIndex& index,
-                                               VolumeSign sign, const Volume& volume,
-                                               float unit_mass) {
-    // Only a cell receiving its first volume can lie outside the bounds of the cells with volumes.
-    if (target.empty()) include(touched_, {index, index});
-    bytes_added_ += target.insert(sign, volume, unit_mass, map_.unit_exponent_);
-  }
   Tile* lookup(std::uint64_t key) {
     if (created_ == nullptr) {
       std::unique_ptr<Tile>& slot = map_.tiles_[key];
@@ -453,129 +287,6 @@ class Map::TileWriter {
       {std::numeric_limits<std::int32_t>::max(), std::numeric_limits<std::int32_t>::max()},
       {std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()}};
 };
-
-InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
-                                   ReadingKind kind, const InsertionConfig& config) {
-  const bool is_obstacle = kind == ReadingKind::kObstacle;
-  config.validate();
-  InsertionResult result;
-  Eigen::Vector3d ray_end;
-  bool obstacle = false;
-  if (!acceptReading(origin, end, is_obstacle, config, ray_end, obstacle, result)) return result;
-  ++revision_;
-  const float unit_mass = static_cast<float>(1.0 / mass_unit_);
-  TileWriter writer(*this, nullptr);
-  volumesOfReading(
-      origin * scale_inverse_, ray_end * scale_inverse_, obstacle, config.model_negative_space,
-      unit_mass, nullptr, [](const CellIndex&) { return true; },
-      [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
-        writer.insert(cell, sign, volume, unit_mass);
-      });
-  bytes_in_cells_ += writer.bytesAdded();
-  growBounds(writer.touched());
-  return result;
-}
-
-InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config) {
-  config.validate();
-  InsertionResult result;
-  struct Reading {
-    Eigen::Vector3d end;  // grid units
-    bool obstacle;
-  };
-  std::vector<Reading> readings;
-  readings.reserve(scan.hits.size() + scan.out_of_range.size());
-  const Eigen::Vector3d& origin = scan.origin;
-  auto accept = [&](const Eigen::Vector3f& end, bool is_obstacle) {
-    Eigen::Vector3d ray_end;
-    bool obstacle = false;
-    if (acceptReading(origin, end.cast<double>(), is_obstacle, config, ray_end, obstacle, result)) {
-      readings.push_back({ray_end * scale_inverse_, obstacle});
-    }
-  };
-  for (const Eigen::Vector3f& hit : scan.hits) accept(hit, true);
-  for (const Eigen::Vector3f& end : scan.out_of_range) accept(end, false);
-  if (readings.empty()) return result;
-  ++revision_;
-
-  const Eigen::Vector3d start = origin * scale_inverse_;
-  const float unit_mass = static_cast<float>(1.0 / mass_unit_);
-  std::unique_ptr<ScanPositives> scan_positives;
-  if (config.clear_conflicting_free_space && config.model_negative_space) {
-    scan_positives = std::make_unique<ScanPositives>();
-    for (const Reading& reading : readings) {
-      if (!reading.obstacle) continue;
-      const auto z = static_cast<float>(reading.end.z());
-      const CellIndex cell = cellAt(reading.end.x(), reading.end.y());
-      (*scan_positives)[packKey(cell.x, cell.y)].push_back(
-          makeVolume(z - 0.5f, z + 0.5f, unit_mass));
-    }
-  }
-  auto volumes_of = [&](const Reading& reading, auto&& owns, auto&& emit) {
-    volumesOfReading(start, reading.end, reading.obstacle, config.model_negative_space, unit_mass,
-                     scan_positives.get(), owns, emit);
-  };
-
-  const auto insertion_threads = static_cast<std::size_t>(config.insertion_threads);
-  if (insertion_threads == 1) {
-    TileWriter writer(*this, nullptr);
-    for (const Reading& reading : readings) {
-      volumes_of(
-          reading, [](const CellIndex&) { return true; },
-          [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
-            writer.insert(cell, sign, volume, unit_mass);
-          });
-    }
-    bytes_in_cells_ += writer.bytesAdded();
-    growBounds(writer.touched());
-    return result;
-  }
-
-  // Several threads, same map: each tile has one owner thread. Every thread walks every reading
-  // in order but inserts only into the tiles it owns, so every cell receives exactly the volumes
-  // of the single-threaded loop above, in the same order. Tiles a thread creates are kept aside
-  // (the tile index is only read while the threads run) and added afterwards.
-  auto owner_of = [insertion_threads](const TileIndex& t) {
-    const auto diagonal = static_cast<std::int64_t>(t.x) + t.y;
-    const auto n = static_cast<std::int64_t>(insertion_threads);
-    return static_cast<std::size_t>(((diagonal % n) + n) % n);
-  };
-  std::vector<std::unordered_map<std::uint64_t, std::unique_ptr<Tile>>> created(insertion_threads);
-  std::vector<std::ptrdiff_t> bytes_added(insertion_threads, 0);
-  std::vector<CellRange> touched(insertion_threads, CellRange{{0, 0}, {-1, -1}});
-  auto insert_owned = [&](std::size_t owner) {
-    TileWriter writer(*this, &created[owner]);
-    // Consecutive cells of a ray mostly share a tile: its owner is computed once per tile.
-    TileIndex last_tile{std::numeric_limits<std::int32_t>::min(), 0};
-    bool owns_last_tile = false;
-    auto owns = [&](const CellIndex& cell) {
-      const TileIndex tile = tileOf(cell);
-      if (tile.x != last_tile.x || tile.y != last_tile.y) {
-        last_tile = tile;
-        owns_last_tile = owner_of(tile) == owner;
-      }
-      return owns_last_tile;
-    };
-    for (const Reading& reading : readings) {
-      volumes_of(reading, owns, [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
-        writer.insert(cell, sign, volume, unit_mass);
-      });
-    }
-    bytes_added[owner] = writer.bytesAdded();
-    touched[owner] = writer.touched();
-  };
-  std::vector<std::thread> workers;
-  for (std::size_t owner = 1; owner < insertion_threads; ++owner)
-    workers.emplace_back(insert_owned, owner);
-  insert_owned(0);
-  for (std::thread& worker : workers) worker.join();
-  for (std::size_t owner = 0; owner < insertion_threads; ++owner) {
-    for (auto& entry : created[owner]) tiles_.emplace(entry.first, std::move(entry.second));
-    bytes_in_cells_ += bytes_added[owner];
-    growBounds(touched[owner]);
-  }
-  return result;
-}
 
 // ---- Queries -------------------------------------------------------------------------------
 
@@ -840,11 +551,13 @@ void Map::setCellVolumes(const CellIndex& index, const CellVolumes& volumes) {
                       ") lies beyond max_coordinate");
   }
   CellVolumes stored = volumes;
+  const std::string problem =
+      checkColumn(stored.positive.data(), stored.positive.size(), stored.negative.data(),
+                  stored.negative.size(), config_.rules.split_free_space_at_obstacles);
+  if (!problem.empty()) throw ConfigError(problem);
   for (VolumeSign sign : {VolumeSign::kPositive, VolumeSign::kNegative}) {
     std::vector<Volume>& list = sign == VolumeSign::kPositive ? stored.positive : stored.negative;
     const char* name = sign == VolumeSign::kPositive ? "positive volumes: " : "negative volumes: ";
-    const std::string problem = checkVolumeList(list.data(), list.size());
-    if (!problem.empty()) throw ConfigError(name + problem);
     for (Volume& v : list) {
       v.mass = static_cast<float>(v.mass / mass_unit_);
       if (!std::isfinite(v.mass)) {

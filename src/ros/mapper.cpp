@@ -17,9 +17,6 @@ namespace {
 
 constexpr double kWarningPeriod = 5.0;          // s between two warnings of one kind
 constexpr double kTransformRetryPeriod = 0.01;  // s between checks for awaited transforms
-// Readings inserted under one hold of the map's lock: ~50 ms at 5 cm, the longest insertion
-// keeps a query waiting.
-constexpr std::size_t kReadingsPerLock = 16384;
 
 /// Creates ~map_directory if missing and returns the map a server starts with: ~map_file if set,
 /// else an empty one. Throws mvog::ConfigError naming the parameter at fault.
@@ -282,17 +279,10 @@ void Mapper::insertionLoop() {
     }
     const auto start = std::chrono::steady_clock::now();
     mvog::InsertionResult result;
-    if (config_.insertion.clear_conflicting_free_space) {
-      // Sec. V.B's conflicts are those within one scan: the scan goes in whole.
+    {
+      // A scan goes in whole: the constraints are applied once per scan (Fig. 2).
       std::unique_lock<WriterPreferringMutex> lock(map_mutex_);
       result = map_.insertScan(pending.scan, config_.insertion);
-    } else {
-      // Piece by piece, the same map (mvog::splitScan), and queries and publications wait for
-      // one piece at most instead of a whole cloud.
-      for (const mvog::Scan& piece : mvog::splitScan(pending.scan, kReadingsPerLock)) {
-        std::unique_lock<WriterPreferringMutex> lock(map_mutex_);
-        result += map_.insertScan(piece, config_.insertion);
-      }
     }
     counters_.insertion_nanoseconds +=
         static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(

@@ -161,7 +161,7 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   read(nh, "max_range", config.insertion.max_range);
   read(nh, "insert_out_of_range", config.insertion.insert_out_of_range);
   read(nh, "model_negative_space", config.insertion.model_negative_space);
-  read(nh, "clear_conflicting_free_space", config.insertion.clear_conflicting_free_space);
+  read(nh, "clear_conflicting_free_space", config.map.rules.clip_free_space_at_hits);
   read(nh, "insertion_threads", config.insertion.insertion_threads);
   read(nh, "frame_id", config.frame_id);
   read(nh, "scan_topics", config.scan_topics);

@@ -112,7 +112,6 @@ int main(int argc, char** argv) {
     mvog::Map map(map_config);
     mvog::InsertionConfig insertion;
     insertion.max_range = 8.0;
-    insertion.clear_conflicting_free_space = true;  // Sec. V.B: keep floor and desk tops
     const std::vector<Box> room = makeRoom();
     std::vector<mvog::Scan> scans;
     for (int k = 0; k < 24; ++k) {  // a loop around the pillar, turning to see every wall

@@ -3,11 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <random>
 #include <sstream>
+#include <unordered_set>
 
 #include <Eigen/Geometry>
 
 #include "mvog/map_io.h"
+#include "mvog/raster.h"
 
 namespace mvog_bench {
 namespace {
@@ -43,10 +47,10 @@ mvog::OccupancyState octomapState(const octomap::OcTree& tree, const Eigen::Vect
 MvogRun runMvog(const InputData& input, const RunOptions& options) {
   mvog::MapConfig map_config;
   map_config.resolution = options.resolution;
+  map_config.rules = options.rules;
   mvog::InsertionConfig insertion;
   insertion.max_range = options.max_range;
   insertion.insertion_threads = options.threads;
-  insertion.clear_conflicting_free_space = options.clear_conflicting_free_space;
   MvogRun run{mvog::Map(map_config), {}};
   MvogStats& stats = run.stats;
   stats.threads = options.threads;
@@ -112,6 +116,222 @@ std::size_t boundingBoxVoxels(const InputData& input, const RunOptions& options)
   return voxels;
 }
 
+namespace {
+
+constexpr double kFarMargin = 3.0;    // m
+constexpr double kFarDistance = 1.0;  // m: the voxel edge of the ray coverage below
+constexpr std::size_t kFarCandidates = 200000;
+constexpr std::size_t kFarPoints = 20000;
+
+/// The 1 m voxels (kFarDistance) that some ray crosses, by a 3D Amanatides-Woo walk.
+std::unordered_set<std::uint64_t> voxelsCrossed(const InputData& input, double max_range) {
+  auto key = [](const Eigen::Vector3i& v) {
+    return (std::uint64_t{static_cast<std::uint16_t>(v.x())} << 32) |
+           (std::uint64_t{static_cast<std::uint16_t>(v.y())} << 16) |
+           std::uint64_t{static_cast<std::uint16_t>(v.z())};
+  };
+  std::unordered_set<std::uint64_t> crossed;
+  for (const mvog::Scan& scan : input.scans) {
+    const Eigen::Vector3d start = scan.origin / kFarDistance;
+    for (const Eigen::Vector3f& hit : scan.hits) {
+      const Eigen::Vector3d end = rayEnd(scan.origin, hit, max_range) / kFarDistance;
+      const Eigen::Vector3d delta = end - start;
+      Eigen::Vector3i voxel = start.array().floor().cast<int>();
+      const Eigen::Vector3i last = end.array().floor().cast<int>();
+      Eigen::Vector3i step;
+      Eigen::Vector3d t_next, t_delta;
+      for (int axis = 0; axis < 3; ++axis) {
+        step[axis] = delta[axis] > 0 ? 1 : -1;
+        const double wall = voxel[axis] + (delta[axis] > 0 ? 1.0 : 0.0);
+        t_next[axis] = delta[axis] != 0.0 ? (wall - start[axis]) / delta[axis] : INFINITY;
+        t_delta[axis] = delta[axis] != 0.0 ? 1.0 / std::fabs(delta[axis]) : INFINITY;
+      }
+      crossed.insert(key(voxel));
+      const int steps = (last - voxel).cwiseAbs().sum();
+      for (int k = 0; k < steps; ++k) {
+        int axis = 0;
+        t_next.minCoeff(&axis);
+        voxel[axis] += step[axis];
+        t_next[axis] += t_delta[axis];
+        crossed.insert(key(voxel));
+      }
+    }
+  }
+  return crossed;
+}
+
+}  // namespace
+
+WalkStats runWalk(const InputData& input, const RunOptions& options) {
+  const double s = 1.0 / options.resolution;
+  mvog::CellRange cells{{0, 0}, {-1, -1}};
+  auto include = [&](const Eigen::Vector3d& p) {
+    const mvog::CellIndex c = mvog::cellAt(p.x() * s, p.y() * s);
+    if (cells.empty()) {
+      cells = {c, c};
+      return;
+    }
+    cells.min = {std::min(cells.min.x, c.x), std::min(cells.min.y, c.y)};
+    cells.max = {std::max(cells.max.x, c.x), std::max(cells.max.y, c.y)};
+  };
+  std::vector<std::vector<Eigen::Vector3d>> ends(input.scans.size());
+  for (std::size_t k = 0; k < input.scans.size(); ++k) {
+    include(input.scans[k].origin);
+    for (const Eigen::Vector3f& hit : input.scans[k].hits) {
+      ends[k].push_back(rayEnd(input.scans[k].origin, hit, options.max_range) * s);
+      include(ends[k].back() / s);
+    }
+  }
+  struct Column {
+    float min = INFINITY;
+    float max = -INFINITY;
+    float sum = 0.0f;
+  };
+  const auto width = static_cast<std::size_t>(cells.width());
+  std::vector<Column> columns(width * static_cast<std::size_t>(cells.height()));
+  WalkStats stats;
+  const auto start_time = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < input.scans.size(); ++k) {
+    const Eigen::Vector3d start = input.scans[k].origin * s;
+    for (const Eigen::Vector3d& end : ends[k]) {
+      mvog::walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
+                    [&](const mvog::CellIndex& cell, double z_enter, double z_exit, bool) {
+                      Column& column =
+                          columns[static_cast<std::size_t>(cell.y - cells.min.y) * width +
+                                  static_cast<std::size_t>(cell.x - cells.min.x)];
+                      const auto low = static_cast<float>(std::min(z_enter, z_exit));
+                      const auto high = static_cast<float>(std::max(z_enter, z_exit));
+                      column.min = std::min(column.min, low);
+                      column.max = std::max(column.max, high);
+                      column.sum += high - low;
+                      ++stats.cell_visits;
+                    });
+    }
+  }
+  stats.insert_seconds = secondsSince(start_time);
+  // Keep the array alive and read, so that the walk is not optimised away.
+  double total = 0.0;
+  for (const Column& column : columns) total += column.sum;
+  if (!std::isfinite(total)) stats.cell_visits = 0;
+  return stats;
+}
+
+SamplePoints samplePoints(const InputData& input, const RunOptions& options,
+                          std::size_t max_rays) {
+  constexpr double kFractions[] = {0.1, 0.3, 0.5, 0.7, 0.9};
+  const std::size_t stride = std::max<std::size_t>(1, (input.readings() + max_rays - 1) / max_rays);
+  SamplePoints points;
+  Eigen::AlignedBox3d box;
+  std::size_t index = 0;
+  for (const mvog::Scan& scan : input.scans) {
+    box.extend(scan.origin);
+    for (const Eigen::Vector3f& hit : scan.hits) {
+      const Eigen::Vector3d end = rayEnd(scan.origin, hit, options.max_range);
+      box.extend(end);
+      if (index++ % stride != 0) continue;
+      ++points.sampled_rays;
+      points.endpoints.push_back(end);
+      for (double fraction : kFractions) {
+        points.along_rays.push_back(scan.origin + fraction * (end - scan.origin));
+      }
+    }
+  }
+  const std::unordered_set<std::uint64_t> crossed = voxelsCrossed(input, options.max_range);
+  auto near_a_ray = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3i voxel = (p / kFarDistance).array().floor().cast<int>();
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const Eigen::Vector3i v = voxel + Eigen::Vector3i(dx, dy, dz);
+          const std::uint64_t key = (std::uint64_t{static_cast<std::uint16_t>(v.x())} << 32) |
+                                    (std::uint64_t{static_cast<std::uint16_t>(v.y())} << 16) |
+                                    std::uint64_t{static_cast<std::uint16_t>(v.z())};
+          if (crossed.count(key) != 0) return true;
+        }
+      }
+    }
+    return false;
+  };
+  const Eigen::Vector3d low = box.min().array() - kFarMargin;
+  const Eigen::Vector3d high = box.max().array() + kFarMargin;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (std::size_t k = 0; k < kFarCandidates && points.far_from_data.size() < kFarPoints; ++k) {
+    const Eigen::Vector3d p(low.x() + unit(rng) * (high.x() - low.x()),
+                            low.y() + unit(rng) * (high.y() - low.y()),
+                            low.z() + unit(rng) * (high.z() - low.z()));
+    if (!near_a_ray(p)) points.far_from_data.push_back(p);
+  }
+  return points;
+}
+
+double StateCounts::percent(mvog::OccupancyState state) const {
+  return points() == 0 ? std::nan("")
+                       : 100.0 * static_cast<double>(counts[stateIndex(state)]) /
+                             static_cast<double>(points());
+}
+
+namespace {
+
+template <class StateOf>
+Quality qualityOf(const SamplePoints& points, StateOf&& state_of) {
+  Quality quality;
+  auto count = [&](const std::vector<Eigen::Vector3d>& at, StateCounts& into) {
+    for (const Eigen::Vector3d& p : at) ++into.counts[stateIndex(state_of(p))];
+  };
+  count(points.endpoints, quality.endpoints);
+  count(points.along_rays, quality.along_rays);
+  count(points.far_from_data, quality.far_from_data);
+  return quality;
+}
+
+}  // namespace
+
+Quality mvogQuality(const mvog::Map& map, double occupancy_threshold, const SamplePoints& points) {
+  if (std::getenv("MVOG_DEBUG")) {
+    std::size_t shown = 0, bad = 0;
+    std::map<std::string, std::size_t> hist;
+    for (const Eigen::Vector3d& p : points.endpoints) {
+      const mvog::PointOccupancy o = map.occupancy(p);
+      if (o.state(occupancy_threshold) == mvog::OccupancyState::kOccupied) continue;
+      ++bad;
+      const mvog::CellIndex c = map.cellAtPoint(p.x(), p.y());
+      const mvog::CellVolumes v = map.cellVolumes(c);
+      const float z = static_cast<float>(p.z() / map.resolution());
+      const mvog::Volume* pos = mvog::findVolume(v.positive.data(), v.positive.size(), z);
+      const mvog::Volume* neg = mvog::findVolume(v.negative.data(), v.negative.size(), z);
+      char key[200];
+      std::snprintf(key, sizeof key, "posh %s negaligned %s ratio %s",
+                    pos ? (pos->height() < 1.5 ? "<1.5" : pos->height() < 3 ? "<3" : ">=3") : "none",
+                    (neg && pos && neg->bottom == pos->bottom && neg->top == pos->top) ? "yes" : "no",
+                    o.negative_density > 3 * o.positive_density ? ">3" : o.negative_density > 1.5 * o.positive_density ? ">1.5" : "<=1.5");
+      ++hist[key];
+      if (shown++ < 12) {
+        std::fprintf(stderr, "z=%.2f rho+ %.3g rho- %.3g | P:", z, o.positive_density, o.negative_density);
+        for (auto& x : v.positive) std::fprintf(stderr, " [%.2f,%.2f|%.2f]", x.bottom, x.top, x.mass);
+        std::fprintf(stderr, " | N:");
+        for (auto& x : v.negative) std::fprintf(stderr, " [%.2f,%.2f|%.2f]", x.bottom, x.top, x.mass);
+        std::fprintf(stderr, "\n");
+      }
+    }
+    std::fprintf(stderr, "bad endpoints %zu of %zu\n", bad, points.endpoints.size());
+    for (double t : {0.5, 0.4, 1.0 / 3.0, 0.25, 0.2}) {
+      std::size_t occ = 0, fr = 0;
+      for (const Eigen::Vector3d& p : points.endpoints) occ += map.occupancy(p).state(t) == mvog::OccupancyState::kOccupied;
+      for (const Eigen::Vector3d& p : points.along_rays) fr += map.occupancy(p).state(t) == mvog::OccupancyState::kFree;
+      std::fprintf(stderr, "threshold %.3f: ends occupied %.1f%% along free %.1f%%\n", t, 100.0 * occ / points.endpoints.size(), 100.0 * fr / points.along_rays.size());
+    }
+    for (auto& [k, n] : hist) std::fprintf(stderr, "  %6zu %s\n", n, k.c_str());
+  }
+  return qualityOf(points, [&](const Eigen::Vector3d& p) {
+    return map.occupancy(p).state(occupancy_threshold);
+  });
+}
+
+Quality octomapQuality(const octomap::OcTree& tree, const SamplePoints& points) {
+  return qualityOf(points, [&](const Eigen::Vector3d& p) { return octomapState(tree, p); });
+}
+
 std::size_t StateAgreement::points() const {
   std::size_t total = 0;
   for (const auto& row : counts) {
@@ -122,26 +342,18 @@ std::size_t StateAgreement::points() const {
 
 std::size_t StateAgreement::agreeing() const { return counts[0][0] + counts[1][1] + counts[2][2]; }
 
-Agreement compareMaps(const InputData& input, const RunOptions& options, const mvog::Map& map,
-                      const octomap::OcTree& tree, std::size_t max_rays) {
-  constexpr double kFractions[] = {0.1, 0.3, 0.5, 0.7, 0.9};
-  const std::size_t stride = std::max<std::size_t>(1, (input.readings() + max_rays - 1) / max_rays);
+Agreement compareMaps(const SamplePoints& points, const mvog::Map& map,
+                      double occupancy_threshold, const octomap::OcTree& tree) {
   Agreement agreement;
-  auto compare = [&](const Eigen::Vector3d& p, StateAgreement& into) {
-    ++into.counts[stateIndex(map.occupancy(p).state(0.5))][stateIndex(octomapState(tree, p))];
-  };
-  std::size_t index = 0;
-  for (const mvog::Scan& scan : input.scans) {
-    for (const Eigen::Vector3f& hit : scan.hits) {
-      if (index++ % stride != 0) continue;
-      ++agreement.sampled_rays;
-      const Eigen::Vector3d end = rayEnd(scan.origin, hit, options.max_range);
-      compare(end, agreement.endpoints);
-      for (double fraction : kFractions) {
-        compare(scan.origin + fraction * (end - scan.origin), agreement.along_rays);
-      }
+  agreement.sampled_rays = points.sampled_rays;
+  auto compare = [&](const std::vector<Eigen::Vector3d>& at, StateAgreement& into) {
+    for (const Eigen::Vector3d& p : at) {
+      ++into.counts[stateIndex(map.occupancy(p).state(occupancy_threshold))]
+                   [stateIndex(octomapState(tree, p))];
     }
-  }
+  };
+  compare(points.endpoints, agreement.endpoints);
+  compare(points.along_rays, agreement.along_rays);
   return agreement;
 }
 

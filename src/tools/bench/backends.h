@@ -19,9 +19,10 @@ struct RunOptions {
   /// backends (OctoMap's insertPointCloud maxrange); infinity: no limit.
   double max_range = 0.0;
   int threads = 1;  ///< MVOG only; OctoMap's insertion is single-threaded
-  /// MVOG only: InsertionConfig::clear_conflicting_free_space (Sec. V.B), the counterpart of
-  /// OctoMap's insertPointCloud, where a scan's occupied voxels win over its free ones.
-  bool clear_conflicting_free_space = false;
+  /// MVOG only: the model's rules (MapConfig::rules).
+  mvog::ModelRules rules;
+  /// MVOG only: occupied where p is above it.
+  double occupancy_threshold = mvog::kDefaultOccupancyThreshold;
 };
 
 struct MvogStats {
@@ -67,8 +68,47 @@ std::size_t octomapBinaryFileBytes(octomap::OcTree& tree);
 /// Cells of the smallest 3D grid at `resolution` holding every ray (origins and ends).
 std::size_t boundingBoxVoxels(const InputData& input, const RunOptions& options);
 
-/// Occupied / free / unknown of both maps at the same points: counts[mvog][octomap], indexed
-/// by mvog::OccupancyState (unknown, free, occupied).
+/// The bare walk, the floor of MVOG's insertion: the same rays through mvog::walkRay with
+/// nothing per visited cell but a min, a max and an add into a dense array of the cells.
+struct WalkStats {
+  double insert_seconds = 0.0;
+  std::size_t cell_visits = 0;
+};
+WalkStats runWalk(const InputData& input, const RunOptions& options);
+
+/// Where the maps are asked: at most `max_rays` rays sampled evenly over the input, and points
+/// far from every ray.
+struct SamplePoints {
+  std::size_t sampled_rays = 0;
+  std::vector<Eigen::Vector3d> endpoints;   ///< each sampled ray's end (truncated to max_range)
+  std::vector<Eigen::Vector3d> along_rays;  ///< at 10, 30, 50, 70 and 90 % of each sampled ray
+  /// Random points of the data's bounding box grown by kFarMargin, more than kFarDistance from
+  /// every ray (none of their 1 m voxels and their neighbours is crossed by a ray): nothing
+  /// was seen there.
+  std::vector<Eigen::Vector3d> far_from_data;
+};
+SamplePoints samplePoints(const InputData& input, const RunOptions& options,
+                          std::size_t max_rays);
+
+/// How many of some points a map calls unknown, free and occupied (index: mvog::OccupancyState).
+struct StateCounts {
+  std::array<std::size_t, 3> counts{};
+  std::size_t points() const { return counts[0] + counts[1] + counts[2]; }
+  /// Percentage of the points in `state` (NaN without points).
+  double percent(mvog::OccupancyState state) const;
+};
+
+/// What a map says at the sample points (MVOG: occupancy().state(threshold); OctoMap: search(), null
+/// = unknown, else isNodeOccupied()).
+struct Quality {
+  StateCounts endpoints;      ///< an obstacle was certainly there: occupied is right
+  StateCounts along_rays;     ///< the ray passed: free is right
+  StateCounts far_from_data;  ///< nothing was seen: unknown is right
+};
+Quality mvogQuality(const mvog::Map& map, double occupancy_threshold, const SamplePoints& points);
+Quality octomapQuality(const octomap::OcTree& tree, const SamplePoints& points);
+
+/// Occupied / free / unknown of both maps at the same points: counts[mvog][octomap].
 struct StateAgreement {
   std::array<std::array<std::size_t, 3>, 3> counts{};
 
@@ -78,13 +118,11 @@ struct StateAgreement {
 
 struct Agreement {
   std::size_t sampled_rays = 0;
-  StateAgreement endpoints;   ///< each sampled ray's end (truncated to max_range)
-  StateAgreement along_rays;  ///< points at 10, 30, 50, 70 and 90 % of each sampled ray
+  StateAgreement endpoints;
+  StateAgreement along_rays;
 };
 
-/// Samples at most `max_rays` rays evenly over the input and compares the maps along them
-/// (MVOG: occupancy().state(0.5); OctoMap: search(), null = unknown, else isNodeOccupied()).
-Agreement compareMaps(const InputData& input, const RunOptions& options, const mvog::Map& map,
-                      const octomap::OcTree& tree, std::size_t max_rays);
+Agreement compareMaps(const SamplePoints& points, const mvog::Map& map,
+                      double occupancy_threshold, const octomap::OcTree& tree);
 
 }  // namespace mvog_bench

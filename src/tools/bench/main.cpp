@@ -1,7 +1,8 @@
 // mvog_bench: MVOG against OctoMap on the same rays from a ROS bag or an OctoMap scan graph.
 //   mvog_bench --input FILE [--resolution R]... [--max-range M] [--threads N]
-//              [--backend mvog|octomap|both] [--json OUT] [--fixed-frame FRAME]
-//              [--clear-conflicting-free-space]
+//              [--backend mvog|octomap|walk|both|all] [--json OUT] [--fixed-frame FRAME]
+//              [--model default|paper] [--clip-free-space-at-hits on|off]
+//              [--mass-counting per-scan|per-reading] [--split-free-space-at-obstacles on|off]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
 #include <chrono>
 #include <cmath>
@@ -18,7 +19,7 @@
 
 namespace {
 
-/// Rays sampled for the occupancy agreement of the two maps (a few seconds of queries at most).
+/// Rays sampled for the quality and agreement of the maps (a few seconds of queries at most).
 constexpr std::size_t kAgreementRays = 20000;
 
 struct Arguments {
@@ -26,9 +27,11 @@ struct Arguments {
   std::vector<double> resolutions;
   double max_range = std::numeric_limits<double>::infinity();
   int threads = 1;
-  bool clear_conflicting_free_space = false;
-  bool run_mvog = true;
-  bool run_octomap = true;
+  mvog::ModelRules rules;
+  std::optional<double> occupancy_threshold;  ///< default: the rules' (the paper's for --model paper)
+  bool run_mvog = false;
+  bool run_octomap = false;
+  bool run_walk = false;
   std::string json;
   std::string fixed_frame = "map";
 };
@@ -40,16 +43,22 @@ class UsageError : public std::runtime_error {
 
 constexpr const char* kUsage =
     "usage: mvog_bench --input FILE [--resolution R]... [--max-range M] [--threads N]\n"
-    "                  [--backend mvog|octomap|both] [--json OUT] [--fixed-frame FRAME]\n"
-    "                  [--clear-conflicting-free-space]\n"
+    "                  [--backend mvog|octomap|walk|both|all] [--json OUT] [--fixed-frame FRAME]\n"
+    "                  [--model default|paper] [--clip-free-space-at-hits on|off]\n"
+    "                  [--mass-counting per-scan|per-reading]\n"
+    "                  [--split-free-space-at-obstacles on|off] [--occupancy-threshold T]\n"
     "  FILE        a ROS bag (LaserScan and/or PointCloud2, poses from /tf and /tf_static)\n"
     "              or an OctoMap ScanGraph (.graph)\n"
     "  R           cell size in metres, repeatable (default 0.1)\n"
     "  M           hits further than M metres insert free space only, truncated (default: none)\n"
     "  N           MVOG insertion threads (default 1; OctoMap always uses one)\n"
+    "  --backend   repeatable: mvog, octomap, walk (the bare ray walk, MVOG's floor), both\n"
+    "              (mvog and octomap, the default) or all\n"
     "  FRAME       the bag's world frame (default map)\n"
-    "  --clear-conflicting-free-space  MVOG's Sec. V.B option: a scan's free space never\n"
-    "              overlaps its own hits (OctoMap's insertPointCloud does the same per voxel)\n";
+    "  T           MVOG is occupied where p > T (default: mvog::kDefaultOccupancyThreshold,\n"
+    "              the paper's 0.5 with --model paper)\n"
+    "  --model     MVOG's rules: the defaults, or the paper's exact model; the options after\n"
+    "              it change one rule each (mvog::ModelRules, README's decisions table)\n";
 
 double positiveNumber(const std::string& option, const std::string& text) {
   char* end = nullptr;
@@ -60,15 +69,18 @@ double positiveNumber(const std::string& option, const std::string& text) {
   return value;
 }
 
+bool onOff(const std::string& option, const std::string& value) {
+  if (value != "on" && value != "off") {
+    throw UsageError(option + " must be on or off, got '" + value + "'");
+  }
+  return value == "on";
+}
+
 Arguments parseArguments(int argc, char** argv) {
   Arguments arguments;
   for (int k = 1; k < argc; ++k) {
     const std::string option = argv[k];
     if (option == "--help" || option == "-h") throw UsageError("");
-    if (option == "--clear-conflicting-free-space") {
-      arguments.clear_conflicting_free_space = true;
-      continue;
-    }
     if (k + 1 >= argc) throw UsageError("unknown option or missing value: " + option);
     const std::string value = argv[++k];
     if (option == "--input") {
@@ -84,11 +96,32 @@ Arguments parseArguments(int argc, char** argv) {
       }
       arguments.threads = static_cast<int>(threads);
     } else if (option == "--backend") {
-      if (value != "mvog" && value != "octomap" && value != "both") {
-        throw UsageError("--backend must be mvog, octomap or both, got '" + value + "'");
+      if (value != "mvog" && value != "octomap" && value != "walk" && value != "both" &&
+          value != "all") {
+        throw UsageError("--backend must be mvog, octomap, walk, both or all, got '" + value + "'");
       }
-      arguments.run_mvog = value != "octomap";
-      arguments.run_octomap = value != "mvog";
+      arguments.run_mvog |= value == "mvog" || value == "both" || value == "all";
+      arguments.run_octomap |= value == "octomap" || value == "both" || value == "all";
+      arguments.run_walk |= value == "walk" || value == "all";
+    } else if (option == "--occupancy-threshold") {
+      const double threshold = positiveNumber(option, value);
+      if (threshold >= 1.0) throw UsageError("--occupancy-threshold must be in (0, 1)");
+      arguments.occupancy_threshold = threshold;
+    } else if (option == "--model") {
+      if (value != "default" && value != "paper") {
+        throw UsageError("--model must be default or paper, got '" + value + "'");
+      }
+      arguments.rules = value == "paper" ? mvog::ModelRules::paper() : mvog::ModelRules{};
+    } else if (option == "--clip-free-space-at-hits") {
+      arguments.rules.clip_free_space_at_hits = onOff(option, value);
+    } else if (option == "--split-free-space-at-obstacles") {
+      arguments.rules.split_free_space_at_obstacles = onOff(option, value);
+    } else if (option == "--mass-counting") {
+      if (value != "per-scan" && value != "per-reading") {
+        throw UsageError("--mass-counting must be per-scan or per-reading, got '" + value + "'");
+      }
+      arguments.rules.mass_counting =
+          value == "per-scan" ? mvog::MassCounting::kPerScan : mvog::MassCounting::kPerReading;
     } else if (option == "--json") {
       arguments.json = value;
     } else if (option == "--fixed-frame") {
@@ -99,7 +132,16 @@ Arguments parseArguments(int argc, char** argv) {
   }
   if (arguments.input.empty()) throw UsageError("--input is required");
   if (arguments.resolutions.empty()) arguments.resolutions.push_back(0.1);
+  if (!arguments.run_mvog && !arguments.run_octomap && !arguments.run_walk) {
+    arguments.run_mvog = arguments.run_octomap = true;
+  }
   return arguments;
+}
+
+double occupancyThreshold(const Arguments& arguments) {
+  return arguments.occupancy_threshold.value_or(arguments.rules == mvog::ModelRules::paper()
+                                                    ? mvog::kPaperOccupancyThreshold
+                                                    : mvog::kDefaultOccupancyThreshold);
 }
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
@@ -108,12 +150,14 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 
 mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
                                                  const mvog_bench::InputData& input,
+                                                 const mvog_bench::SamplePoints& points,
                                                  double resolution) {
   mvog_bench::RunOptions options;
   options.resolution = resolution;
   options.max_range = arguments.max_range;
   options.threads = arguments.threads;
-  options.clear_conflicting_free_space = arguments.clear_conflicting_free_space;
+  options.rules = arguments.rules;
+  options.occupancy_threshold = occupancyThreshold(arguments);
   mvog_bench::ResolutionReport report;
   report.resolution = resolution;
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
@@ -130,9 +174,18 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
     std::fprintf(stderr, "mvog_bench: %.3f m: octomap inserted in %.3f s\n", resolution,
                  octomap->stats.insert_seconds);
   }
+  if (arguments.run_walk) {
+    report.walk = mvog_bench::runWalk(input, options);
+    std::fprintf(stderr, "mvog_bench: %.3f m: the bare walk took %.3f s\n", resolution,
+                 report.walk->insert_seconds);
+  }
+  if (mvog) {
+    report.mvog_quality = mvog_bench::mvogQuality(mvog->map, options.occupancy_threshold, points);
+  }
+  if (octomap) report.octomap_quality = mvog_bench::octomapQuality(*octomap->tree, points);
   if (mvog && octomap) {
     report.agreement =
-        mvog_bench::compareMaps(input, options, mvog->map, *octomap->tree, kAgreementRays);
+        mvog_bench::compareMaps(points, mvog->map, options.occupancy_threshold, *octomap->tree);
   }
   if (octomap) {  // last: writeBinary turns the tree into its maximum-likelihood estimate
     octomap->stats.binary_file_bytes = mvog_bench::octomapBinaryFileBytes(*octomap->tree);
@@ -157,13 +210,18 @@ int main(int argc, char** argv) {
     mvog_bench::BenchReport report;
     report.input_path = arguments.input;
     report.max_range = arguments.max_range;
-    report.clear_conflicting_free_space = arguments.clear_conflicting_free_space;
+    report.rules = arguments.rules;
+    report.occupancy_threshold = occupancyThreshold(arguments);
     const auto start = std::chrono::steady_clock::now();
     const mvog_bench::InputData input =
         mvog_bench::loadInput(arguments.input, arguments.fixed_frame);
     report.load_seconds = secondsSince(start);
+    mvog_bench::RunOptions sampling;
+    sampling.max_range = arguments.max_range;
+    const mvog_bench::SamplePoints points =
+        mvog_bench::samplePoints(input, sampling, kAgreementRays);
     for (double resolution : arguments.resolutions) {
-      report.resolutions.push_back(benchmarkResolution(arguments, input, resolution));
+      report.resolutions.push_back(benchmarkResolution(arguments, input, points, resolution));
     }
     mvog_bench::printReport(report, input, stdout);
     if (!arguments.json.empty()) mvog_bench::writeJson(report, input, arguments.json);

@@ -169,6 +169,13 @@ std::string percent(const StateAgreement& a) {
   return text;
 }
 
+std::string rulesText(const mvog::ModelRules& rules) {
+  return std::string("clip_free_space_at_hits ") + (rules.clip_free_space_at_hits ? "on" : "off") +
+         ", mass_counting " +
+         (rules.mass_counting == mvog::MassCounting::kPerScan ? "per-scan" : "per-reading") +
+         ", split_free_space_at_obstacles " + (rules.split_free_space_at_obstacles ? "on" : "off");
+}
+
 }  // namespace
 
 void printReport(const BenchReport& report, const InputData& input, std::FILE* out) {
@@ -187,8 +194,9 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
   } else {
     std::fprintf(out, "max range   none\n");
   }
-  std::fprintf(out, "MVOG        clear_conflicting_free_space %s\n\n",
-               report.clear_conflicting_free_space ? "on (Sec. V.B)" : "off (as in the paper)");
+  std::fprintf(out, "MVOG rules  %s%s; occupied where p > %.3f\n\n", rulesText(report.rules).c_str(),
+               report.rules == mvog::ModelRules::paper() ? " (the paper's model)" : "",
+               report.occupancy_threshold);
 
   std::fprintf(out, "%-8s %7s %7s %10s %10s %12s %14s %14s %14s\n", "backend", "res (m)", "threads",
                "readings", "insert (s)", "readings/s", "memory (B)", "file (B)", ".ot file (B)");
@@ -205,6 +213,34 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                    perSecond(readings, r.octomap->insert_seconds), r.octomap->memory_bytes,
                    r.octomap->binary_file_bytes, r.octomap->full_file_bytes);
     }
+    if (r.walk) {
+      std::fprintf(out, "%-8s %7.3f %7d %10zu %10.3f %12.0f %14s %14s %14s\n", "walk",
+                   r.resolution, 1, readings, r.walk->insert_seconds,
+                   perSecond(readings, r.walk->insert_seconds), "-", "-", "-");
+    }
+  }
+
+  bool quality_header = false;
+  for (const ResolutionReport& r : report.resolutions) {
+    for (const auto& [name, quality] :
+         {std::make_pair("mvog", &r.mvog_quality), std::make_pair("octomap", &r.octomap_quality)}) {
+      if (!*quality) continue;
+      if (!quality_header) {
+        std::fprintf(out,
+                     "\nQuality (%% of the sample points): ray ends called occupied, points along "
+                     "the rays called free, points far from every ray called unknown\n"
+                     "%-8s %7s %12s %12s %12s %10s %10s\n",
+                     "backend", "res (m)", "ends occ.", "along free", "far unknown", "rays",
+                     "far points");
+        quality_header = true;
+      }
+      const Quality& q = **quality;
+      std::fprintf(out, "%-8s %7.3f %11.1f%% %11.1f%% %11.1f%% %10zu %10zu\n", name,
+                   r.resolution, q.endpoints.percent(mvog::OccupancyState::kOccupied),
+                   q.along_rays.percent(mvog::OccupancyState::kFree),
+                   q.far_from_data.percent(mvog::OccupancyState::kUnknown), q.endpoints.points(),
+                   q.far_from_data.points());
+    }
   }
 
   std::fprintf(out, "\nTable I (single precision; out-of-range readings disregarded)\n");
@@ -217,6 +253,18 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
         megabytes(static_cast<double>(r.voxel_grid_cells) * kVoxelBytes).c_str(),
         optionalMegabytes(r.octomap.has_value(), r.octomap ? r.octomap->memory_bytes : 0).c_str(),
         optionalMegabytes(r.mvog.has_value(), r.mvog ? r.mvog->memory.table_one_bytes : 0).c_str());
+  }
+
+  bool walk_header = false;
+  for (const ResolutionReport& r : report.resolutions) {
+    if (!r.mvog || !r.walk) continue;
+    if (!walk_header) {
+      std::fprintf(out, "\nMVOG / the bare walk\n%7s %12s %14s\n", "res (m)", "time",
+                   "cell visits");
+      walk_header = true;
+    }
+    std::fprintf(out, "%7.3f %11.2fx %14zu\n", r.resolution,
+                 ratio(r.mvog->insert_seconds, r.walk->insert_seconds), r.walk->cell_visits);
   }
 
   bool header = false;
@@ -243,10 +291,38 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
 
 void writeJson(const BenchReport& report, const InputData& input, const std::string& path) {
   const std::size_t readings = input.readings();
-  std::vector<JsonObject> results, table_one, comparison, agreement;
+  std::vector<JsonObject> results, table_one, comparison, agreement, quality;
   for (const ResolutionReport& r : report.resolutions) {
     if (r.mvog) results.push_back(mvogJson(r.resolution, readings, *r.mvog));
     if (r.octomap) results.push_back(octomapJson(r.resolution, readings, *r.octomap));
+    if (r.walk) {
+      JsonObject walk;
+      walk.add("backend", "walk")
+          .add("resolution", r.resolution)
+          .add("readings", readings)
+          .add("insert_seconds", r.walk->insert_seconds)
+          .add("readings_per_second", perSecond(readings, r.walk->insert_seconds))
+          .add("cell_visits", r.walk->cell_visits);
+      if (r.mvog) walk.add("mvog_time_ratio", ratio(r.mvog->insert_seconds, r.walk->insert_seconds));
+      results.push_back(walk);
+    }
+    for (const auto& [name, q] :
+         {std::make_pair("mvog", &r.mvog_quality), std::make_pair("octomap", &r.octomap_quality)}) {
+      if (!*q) continue;
+      JsonObject row;
+      row.add("backend", name)
+          .add("resolution", r.resolution)
+          .add("endpoints_occupied_percent",
+               (*q)->endpoints.percent(mvog::OccupancyState::kOccupied))
+          .add("endpoints_free_percent", (*q)->endpoints.percent(mvog::OccupancyState::kFree))
+          .add("along_rays_free_percent", (*q)->along_rays.percent(mvog::OccupancyState::kFree))
+          .add("along_rays_occupied_percent",
+               (*q)->along_rays.percent(mvog::OccupancyState::kOccupied))
+          .add("far_unknown_percent", (*q)->far_from_data.percent(mvog::OccupancyState::kUnknown))
+          .add("endpoints", (*q)->endpoints.points())
+          .add("far_points", (*q)->far_from_data.points());
+      quality.push_back(row);
+    }
     JsonObject row;
     row.add("resolution", r.resolution)
         .add("point_cloud_bytes", readings * kPointCloudBytesPerPoint)
@@ -289,8 +365,10 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
   document.add("results", results)
       .add("input", input_json)
       .add("max_range", report.max_range)
-      .add("clear_conflicting_free_space", report.clear_conflicting_free_space)
+      .add("rules", rulesText(report.rules))
+      .add("occupancy_threshold", report.occupancy_threshold)
       .add("table_one", table_one)
+      .add("quality", quality)
       .add("comparison", comparison)
       .add("agreement", agreement);
 

@@ -16,6 +16,9 @@ struct ResolutionReport {
   std::size_t voxel_grid_cells = 0;  ///< boundingBoxVoxels()
   std::optional<MvogStats> mvog;
   std::optional<OctomapStats> octomap;
+  std::optional<WalkStats> walk;
+  std::optional<Quality> mvog_quality;
+  std::optional<Quality> octomap_quality;
   std::optional<Agreement> agreement;  ///< when both backends ran
 };
 
@@ -23,7 +26,8 @@ struct BenchReport {
   std::string input_path;
   double load_seconds = 0.0;
   double max_range = 0.0;  ///< infinity: none
-  bool clear_conflicting_free_space = false;
+  mvog::ModelRules rules;
+  double occupancy_threshold = 0.0;
   std::vector<ResolutionReport> resolutions;
 };
 

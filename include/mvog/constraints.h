@@ -1,0 +1,80 @@
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "mvog/volume.h"
+
+namespace mvog {
+
+/// A read-only run of volumes (a list, or new volumes for one).
+struct VolumeRun {
+  const Volume* data = nullptr;
+  std::size_t size = 0;
+
+  VolumeRun() = default;
+  VolumeRun(const Volume* volumes, std::size_t count) : data(volumes), size(count) {}
+  VolumeRun(const std::vector<Volume>& volumes) : data(volumes.data()), size(volumes.size()) {}
+  const Volume* begin() const { return data; }
+  const Volume* end() const { return data + size; }
+};
+
+/// How ListMerger treats a negative list next to the column's positive volumes (ModelRules).
+struct FreeSpaceRules {
+  /// ModelRules::split_free_space_at_obstacles.
+  bool split_at_obstacles = false;
+  /// With ModelRules::clip_free_space_at_hits: a gap that eq. (8) closes gets no mass where a
+  /// positive volume covers it (the space was seen occupied, not assumed free).
+  bool no_gap_mass_over_obstacles = false;
+};
+
+/// Sec. III-B.3, the constraint application of Fig. 2, for one list of one column: the volumes
+/// it receives at once (one scan's, or another map's) are merged with the volumes already there,
+/// overlapping ones (eq. 7: union, masses summed; touching volumes overlap) and those less than
+/// kMaxMergeGap apart (eq. 8: the gap is added at density 1, `unit_mass` per unit height). The
+/// result depends on the set of volumes only, not on their order.
+///
+/// `existing` satisfies Sec. III-A (checkColumn); `added` holds volumes at least kMinVolumeHeight
+/// high (eq. 6 already applied), in any order, overlapping or not. Masses are in one unit.
+///
+/// Merging a negative list, `obstacles` is the column's positive list (as this same update left
+/// it) and `rules` say how it matters; merging a positive list, both are empty. With
+/// `split_at_obstacles`, the merged negative volumes are cut at the bottom and top of every
+/// positive volume they overlap, and each piece gets the mass that fell within its heights (a
+/// source spanning several pieces shares its mass in proportion to their overlap, as its density
+/// is uniform): within a positive volume's heights the negative list holds one piece spanning
+/// exactly those heights (Sec. V.C: the free space seen within an obstacle is not averaged with
+/// the free column around it); a piece outside them lower than kMinVolumeHeight joins the
+/// obstacle's piece next to it.
+class ListMerger {
+ public:
+  /// Writes the merged list to `out` (sorted, satisfying Sec. III-A).
+  void merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles, FreeSpaceRules rules,
+             float unit_mass, std::vector<Volume>& out);
+
+ private:
+  /// A volume whose mass contributes to the merged list (its density is uniform over it).
+  struct Source {
+    float bottom;
+    float top;
+    double mass;
+  };
+  /// A run of the merged list before it is cut, with the obstacles [first, end) of inside_ in it.
+  struct Component {
+    float bottom;
+    float top;
+    std::size_t first_inside;
+    std::size_t end_inside;
+  };
+  void sweep();
+  void addPieces(const Component& component, std::vector<Volume>& out) const;
+  double massWithin(float bottom, float top) const;
+
+  std::vector<Source> sources_;        // sorted by (bottom, top, mass)
+  std::vector<Source> gaps_;           // gaps closed by eq. (8), upwards
+  std::vector<Volume> inside_;         // the obstacles the free space reaches into
+  std::vector<Volume> reached_;        // the same, as found by the last sweep
+  std::vector<Component> components_;  // upwards
+};
+
+}  // namespace mvog

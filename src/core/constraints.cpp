@@ -1,0 +1,140 @@
+#include "mvog/constraints.h"
+
+#include <algorithm>
+#include <tuple>
+
+namespace mvog {
+
+namespace {
+
+/// Length of [bottom, top] that the sorted, disjoint `volumes` cover.
+double coveredLength(float bottom, float top, VolumeRun volumes) {
+  double covered = 0.0;
+  for (const Volume& v : volumes) {
+    if (v.bottom >= top) break;
+    const double overlap = static_cast<double>(std::min(top, v.top)) - std::max(bottom, v.bottom);
+    if (overlap > 0.0) covered += overlap;
+  }
+  return covered;
+}
+
+bool overlaps(float bottom, float top, const Volume& v) { return v.bottom < top && bottom < v.top; }
+
+}  // namespace
+
+void ListMerger::merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles,
+                       FreeSpaceRules rules, float unit_mass, std::vector<Volume>& out) {
+  out.clear();
+  sources_.clear();
+  inside_.clear();
+  for (const VolumeRun& run : {existing, added}) {
+    for (const Volume& v : run) sources_.push_back({v.bottom, v.top, v.mass});
+  }
+  if (sources_.empty()) return;
+  // Sorted by every field, so that the sums below run in an order the set alone decides.
+  std::sort(sources_.begin(), sources_.end(), [](const Source& a, const Source& b) {
+    return std::tie(a.bottom, a.top, a.mass) < std::tie(b.bottom, b.top, b.mass);
+  });
+  // With splitting, the obstacles that the free space reaches into join it (their heights are
+  // its pieces), which may join runs that were apart: sweep until no new obstacle is reached.
+  for (;;) {
+    sweep();
+    if (!rules.split_at_obstacles) break;
+    reached_.clear();
+    std::size_t c = 0;
+    for (const Volume& obstacle : obstacles) {
+      while (c < components_.size() && components_[c].top <= obstacle.bottom) ++c;
+      if (c < components_.size() && overlaps(components_[c].bottom, components_[c].top, obstacle)) {
+        reached_.push_back(obstacle);
+      }
+    }
+    if (reached_.size() == inside_.size()) break;  // inside_ is a subset of reached_
+    inside_.swap(reached_);
+  }
+  for (Source& gap : gaps_) {
+    double free_length = static_cast<double>(gap.top) - gap.bottom;
+    if (rules.no_gap_mass_over_obstacles) free_length -= coveredLength(gap.bottom, gap.top, obstacles);
+    gap.mass = free_length * unit_mass;
+  }
+  for (const Component& component : components_) addPieces(component, out);
+}
+
+void ListMerger::sweep() {
+  // Upwards over the sources and the obstacles joined: overlaps join (eq. 7), gaps of at most
+  // kMaxMergeGap are closed (eq. 8). Sorted by bottom, no later volume can reach into a gap once
+  // the sweep has passed it.
+  components_.clear();
+  gaps_.clear();
+  std::size_t next_source = 0;
+  std::size_t next_inside = 0;
+  while (next_source < sources_.size() || next_inside < inside_.size()) {
+    const bool take_inside =
+        next_inside < inside_.size() && (next_source == sources_.size() ||
+                                         inside_[next_inside].bottom < sources_[next_source].bottom);
+    const float bottom = take_inside ? inside_[next_inside].bottom : sources_[next_source].bottom;
+    const float top = take_inside ? inside_[next_inside].top : sources_[next_source].top;
+    if (components_.empty() || !mustMerge(components_.back().top, bottom)) {
+      components_.push_back({bottom, top, next_inside, next_inside});
+    } else {
+      Component& last = components_.back();
+      if (bottom > last.top) gaps_.push_back({last.top, bottom, 0.0});
+      last.top = std::max(last.top, top);
+    }
+    if (take_inside) {
+      components_.back().end_inside = ++next_inside;
+    } else {
+      ++next_source;
+    }
+  }
+}
+
+void ListMerger::addPieces(const Component& component, std::vector<Volume>& out) const {
+  const std::size_t first_piece = out.size();
+  if (component.first_inside == component.end_inside) {
+    out.push_back({component.bottom, component.top, 0.0f});
+  } else {
+    // Cut at the obstacles' heights: outside, inside, outside, ... Obstacles lie more than
+    // kMaxMergeGap apart, so only a first or last outside piece can be too low: it joins its
+    // obstacle's piece.
+    float below = component.bottom;
+    for (std::size_t k = component.first_inside; k != component.end_inside; ++k) {
+      const Volume& obstacle = inside_[k];
+      if (obstacle.bottom > below &&
+          (k != component.first_inside || obstacle.bottom - below >= kMinVolumeHeight)) {
+        out.push_back({below, obstacle.bottom, 0.0f});
+        below = obstacle.bottom;
+      }
+      out.push_back({below, obstacle.top, 0.0f});
+      below = obstacle.top;
+    }
+    if (below < component.top) {
+      if (component.top - below < kMinVolumeHeight) {
+        out.back().top = component.top;
+      } else {
+        out.push_back({below, component.top, 0.0f});
+      }
+    }
+  }
+  for (std::size_t k = first_piece; k < out.size(); ++k) {
+    out[k].mass = static_cast<float>(massWithin(out[k].bottom, out[k].top));
+  }
+}
+
+double ListMerger::massWithin(float bottom, float top) const {
+  double mass = 0.0;
+  for (const std::vector<Source>* list : {&sources_, &gaps_}) {
+    for (const Source& s : *list) {
+      if (s.bottom >= top) break;  // both lists run upwards
+      if (s.bottom >= bottom && s.top <= top) {
+        mass += s.mass;
+        continue;
+      }
+      const double overlap =
+          static_cast<double>(std::min(top, s.top)) - std::max(bottom, s.bottom);
+      if (overlap > 0.0) mass += s.mass * overlap / (static_cast<double>(s.top) - s.bottom);
+    }
+  }
+  return mass;
+}
+
+}  // namespace mvog
