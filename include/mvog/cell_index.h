@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -32,6 +33,24 @@ struct CellRange {
   bool contains(const CellIndex& c) const {
     return c.x >= min.x && c.x <= max.x && c.y >= min.y && c.y <= max.y;
   }
+  bool intersects(const CellRange& other) const {
+    return !empty() && !other.empty() && other.max.x >= min.x && other.min.x <= max.x &&
+           other.max.y >= min.y && other.min.y <= max.y;
+  }
+  /// Grows to hold `other` too (an empty `other` changes nothing).
+  void extend(const CellRange& other) {
+    if (other.empty()) return;
+    if (empty()) {
+      *this = other;
+      return;
+    }
+    min = {std::min(min.x, other.min.x), std::min(min.y, other.min.y)};
+    max = {std::max(max.x, other.max.x), std::max(max.y, other.max.y)};
+  }
+  void extend(const CellIndex& cell) { extend(CellRange{cell, cell}); }
 };
+
+/// The range holding no cell.
+constexpr CellRange kNoCells{{0, 0}, {-1, -1}};
 
 }  // namespace mvog

@@ -71,6 +71,7 @@ class ListMerger {
   double massWithin(float bottom, float top) const;
 
   std::vector<Source> sources_;        // sorted by (bottom, top, mass)
+  std::vector<Source> added_;          // the added volumes, sorted
   std::vector<Source> gaps_;           // gaps closed by eq. (8), upwards
   std::vector<Volume> inside_;         // the obstacles the free space reaches into
   std::vector<Volume> reached_;        // the same, as found by the last sweep

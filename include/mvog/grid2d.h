@@ -16,7 +16,7 @@ enum class OccupancyState : std::uint8_t { kUnknown = 0, kFree = 1, kOccupied = 
 template <class T>
 struct Grid2D {
   double resolution = 0.0;
-  CellRange cells{{0, 0}, {-1, -1}};
+  CellRange cells = kNoCells;
   std::vector<T> values;
 
   std::size_t width() const { return static_cast<std::size_t>(cells.width()); }

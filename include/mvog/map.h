@@ -5,7 +5,6 @@
 #include <functional>
 #include <memory>
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -33,14 +32,6 @@ struct Scan {
   std::vector<Eigen::Vector3f> out_of_range;
 };
 
-/// Splits `scan` into consecutive pieces of at most `max_readings` readings each (its hits, then
-/// its free endpoints, in order), all from its origin. Inserting the pieces in order builds the
-/// same map as inserting `scan`, since the readings go in in the same order; not so with
-/// InsertionConfig::clear_conflicting_free_space, whose conflicts are those within one scan.
-/// A server inserts a large cloud piece by piece so that queries get the map in between.
-/// An empty scan has no piece. Throws ConfigError if `max_readings` is 0.
-std::vector<Scan> splitScan(const Scan& scan, std::size_t max_readings);
-
 /// What happened to the readings given to an insertion. Every reading is counted exactly once.
 struct InsertionResult {
   std::size_t obstacle_readings = 0;       ///< inserted with a positive volume
@@ -50,6 +41,10 @@ struct InsertionResult {
   std::size_t rejected_out_of_bounds = 0;  ///< beyond MapConfig::max_coordinate
   std::size_t rejected_too_close = 0;      ///< hits nearer than min_range
   std::size_t ignored_out_of_range = 0;    ///< out-of-range readings with insert_out_of_range off
+  /// Time spent rasterising the obstacle readings and the out-of-range readings (thread time,
+  /// summed over the insertion's threads): how much the readings without a return cost.
+  double obstacle_seconds = 0.0;
+  double out_of_range_seconds = 0.0;
 
   std::size_t inserted() const { return obstacle_readings + out_of_range_readings; }
   std::size_t rejected() const {
@@ -101,6 +96,11 @@ struct TileIndex {
   }
 };
 
+class ScanUpdate;
+namespace detail {
+class TileBlock;
+}
+
 /// A Multi-Volume Occupancy Grid (Dryanovski, Morris, Xiao, IROS 2010).
 ///
 /// Not thread-safe: callers serialise writers against readers (const methods may run
@@ -121,14 +121,20 @@ class Map {
   const MapConfig& config() const { return config_; }
   double resolution() const { return config_.resolution; }
 
-  // ---- Insertion (Sec. III-B) ------------------------------------------------------------
+  // ---- Insertion (Sec. III-B, Fig. 2) -----------------------------------------------------
 
-  /// Inserts one reading ending at `end`: an obstacle reading, or an out-of-range reading.
+  /// Inserts a whole scan as Fig. 2 draws it: every reading rasterised and its new volumes
+  /// created (ScanUpdate::prepare), then the constraints applied once to every list the scan
+  /// modified (apply). The map depends on the set of the scan's new volumes only: not on the
+  /// order of its readings, nor on config.insertion_threads.
+  InsertionResult insertScan(const Scan& scan, const InsertionConfig& config = {});
+  /// The scan of one reading ending at `end`: an obstacle reading, or an out-of-range reading.
   InsertionResult insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
                                 ReadingKind kind, const InsertionConfig& config = {});
-  /// Inserts a whole scan: the same map as inserting its hits, then its free endpoints, one by
-  /// one in order (unless config.clear_conflicting_free_space), with any number of threads.
-  InsertionResult insertScan(const Scan& scan, const InsertionConfig& config = {});
+  /// The second half of insertScan: applies the constraints (eqs. 6-8, the model's rules) to
+  /// every list `update` reaches, with its new volumes. Throws ConfigError if the update was
+  /// prepared for another configuration (resolution, max_coordinate, rules).
+  InsertionResult apply(ScanUpdate& update);
 
   // ---- Queries (Sec. III-C) ---------------------------------------------------------------
 
@@ -150,7 +156,8 @@ class Map {
   /// Cells of the world rectangle [min_x, max_x] x [min_y, max_y] (m).
   CellRange cellsInRectangle(double min_x, double min_y, double max_x, double max_y) const;
 
-  /// Calls visit(CellIndex, VolumeSign, const Volume&) for every volume (masses as of now).
+  /// Calls visit(CellIndex, VolumeSign, const Volume&) for every volume (masses as of now), tile
+  /// rows from the lowest, each tile's cells row by row.
   void forEachVolume(
       const std::function<void(const CellIndex&, VolumeSign, const Volume&)>& visit) const;
   /// Same, restricted to the cells of `cells`.
@@ -161,11 +168,11 @@ class Map {
   // ---- Decay (Sec. III-E) -----------------------------------------------------------------
 
   /// Multiplies every mass by k_d in (0, 1], in O(1): masses are stored in a unit that a single
-  /// factor converts, so no cell is touched. A cell's stored masses are rescaled, exactly by a
-  /// power of two, only when the cell next receives a volume. Hence the probabilities of a cell
-  /// that receives no new reading stay bit for bit the same after any number of steps; in a
-  /// cell that does, masses decayed below float range relative to the new ones become 0. Masses
-  /// and densities read back (cellVolumes, occupancy) underflow to 0 after extreme decay.
+  /// factor converts, so no tile is touched. A tile's stored masses are rescaled, exactly by a
+  /// power of two, only when the tile is next written. Hence the probabilities of a tile that
+  /// receives no new reading stay bit for bit the same after any number of steps; in a tile
+  /// that does, masses decayed below float range relative to the new ones become 0. Masses and
+  /// densities read back (cellVolumes, occupancy) underflow to 0 after extreme decay.
   /// Increases revision() (unless k_d = 1) but marks no tile: no probability changes.
   void decay(double k_d);
 
@@ -184,44 +191,46 @@ class Map {
     return {cell.x >> kTileSizeLog2, cell.y >> kTileSizeLog2};  // arithmetic shift floors
   }
 
-  // ---- Direct access for serialisation ------------------------------------------------------
+  // ---- Direct access (serialisation, merging) ----------------------------------------------
 
-  /// Replaces a cell's lists (masses as cellVolumes returns them). Throws ConfigError unless both
-  /// lists satisfy the Sec. III-A constraints (sorted, heights >= 1, gaps > 1, finite
-  /// non-negative masses, representable in the map's decayed mass unit) and the cell lies within
-  /// max_coordinate (|i|, |j| <= max_coordinate / resolution + 1, the cells readings can reach).
+  /// A cell's new lists (masses as cellVolumes returns them).
+  struct CellAssignment {
+    CellIndex cell;
+    CellVolumes volumes;
+  };
+  /// Replaces the lists of the cells given (each tile is rewritten once, whatever the number of
+  /// its cells given). Throws ConfigError, changing nothing, unless every list satisfies the
+  /// Sec. III-A constraints (checkColumn under the map's rules; finite non-negative masses
+  /// representable in the map's decayed mass unit), every cell lies within max_coordinate (|i|,
+  /// |j| <= max_coordinate / resolution + 1, the cells readings can reach) and appears once.
   /// Emptying a cell removes it from bounds().
+  void setCellVolumes(const std::vector<CellAssignment>& cells);
   void setCellVolumes(const CellIndex& cell, const CellVolumes& volumes);
 
  private:
-  struct Tile;
-  class Cell;
-  class TileWriter;
-  friend struct MapFileAccess;
+  struct Storage;
 
-  const Cell* findCell(const CellIndex& cell) const;
-  const Tile* findTile(const TileIndex& index) const;
-  std::vector<std::uint64_t> sortedTileKeys() const;
-  bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, ReadingKind kind,
-                     const InsertionConfig& config, Eigen::Vector3d& ray_end, bool& obstacle,
-                     InsertionResult& result) const;
+  const detail::TileBlock* findTile(std::uint64_t key) const;
   template <class T, class CellValue>
   Grid2D<T> fillGrid(const CellRange& cells, T unobserved, CellValue&& value_of) const;
-  double realMass(const Cell& cell, float stored_mass) const;
-  void growBounds(const CellRange& cells);
+  /// Real mass of a stored mass of a tile written with mass exponent `tile_exponent`.
+  double realMass(std::int32_t tile_exponent, float stored_mass) const;
+  /// Scale from a tile's stored masses to the map's current unit (a power of two).
+  double rescaleOf(std::int32_t tile_exponent) const;
+  std::vector<std::uint64_t> sortedTileKeys() const;
   void recomputeBounds();
 
   MapConfig config_;
   double scale_inverse_;  // 1 / resolution
-  /// Stored masses of a cell are in units of mass_unit_ * 2^(unit_exponent_ - the cell's
+  /// Stored masses of a tile are in units of mass_unit_ * 2^(unit_exponent_ - the tile's
   /// exponent) real mass, mass_unit_ in (0.5, 1]. Decay changes these two only (Sec. III-E in
-  /// O(1)); a cell takes the map's unit exponent when it is written.
+  /// O(1)); a tile takes the map's unit exponent when it is written.
   double mass_unit_ = 1.0;
   std::int64_t unit_exponent_ = 0;
-  std::unordered_map<std::uint64_t, std::unique_ptr<Tile>> tiles_;
+  std::unique_ptr<Storage> storage_;
+  std::unique_ptr<ScanUpdate> own_update_;  // insertScan's buffers, kept from scan to scan
   std::uint64_t revision_ = 1;
-  CellRange bounds_{{0, 0}, {-1, -1}};
-  std::size_t bytes_in_cells_ = 0;
+  CellRange bounds_ = kNoCells;
 };
 
 }  // namespace mvog

@@ -42,19 +42,21 @@ inline bool mustMerge(float lower_top, float upper_bottom) {
 /// its centre. Its mass is that of density 1 over its final height: every new volume starts at
 /// density 1 (Sec. III-B.2).
 inline Volume makeVolume(float z_a, float z_b) {
-  Volume volume{std::min(z_a, z_b), std::max(z_a, z_b), 0.0f};
+  const float low = std::min(z_a, z_b);
+  const float high = std::max(z_a, z_b);
+  // Both candidates are computed and one selected: whether a ray's crossing of a cell is lower
+  // than 1 follows no pattern a branch predictor could learn, and this runs for every cell.
+  const float centre = 0.5f * (low + high);  // eq. (6)
+  const bool lift = high - low < kMinVolumeHeight;
+  Volume volume{lift ? centre - 0.5f * kMinVolumeHeight : low,
+                lift ? centre + 0.5f * kMinVolumeHeight : high, 0.0f};
+  // The float sums may round to just under the minimum height. Then raise the top to bottom + 1,
+  // and one float further if that sum rounds down too (then it lies above it). Nudging the top up
+  // one float at a time until the height is 1, as before, could take billions of steps when the
+  // top lies just below zero (found by fuzzing).
   if (volume.height() < kMinVolumeHeight) {
-    const float centre = 0.5f * (volume.bottom + volume.top);  // eq. (6)
-    volume.bottom = centre - 0.5f * kMinVolumeHeight;
-    volume.top = centre + 0.5f * kMinVolumeHeight;
-    // The float sums may round to just under the minimum height. Then raise the top to
-    // bottom + 1, and one float further if that sum rounds down too (then it lies above it).
-    // Nudging the top up one float at a time until the height is 1, as before, could take
-    // billions of steps when the top lies just below zero (found by fuzzing).
-    if (volume.height() < kMinVolumeHeight) {
-      volume.top = std::max(volume.top, volume.bottom + kMinVolumeHeight);
-      if (volume.height() < kMinVolumeHeight) volume.top = std::nextafter(volume.top, INFINITY);
-    }
+    volume.top = std::max(volume.top, volume.bottom + kMinVolumeHeight);
+    if (volume.height() < kMinVolumeHeight) volume.top = std::nextafter(volume.top, INFINITY);
   }
   volume.mass = volume.height();
   return volume;

@@ -27,19 +27,32 @@ void ListMerger::merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles,
   out.clear();
   sources_.clear();
   inside_.clear();
-  for (const VolumeRun& run : {existing, added}) {
-    for (const Volume& v : run) sources_.push_back({v.bottom, v.top, v.mass});
-  }
-  if (sources_.empty()) return;
   // Sorted by every field, so that the sums below run in an order the set alone decides.
-  std::sort(sources_.begin(), sources_.end(), [](const Source& a, const Source& b) {
+  auto before = [](const Source& a, const Source& b) {
     return std::tie(a.bottom, a.top, a.mass) < std::tie(b.bottom, b.top, b.mass);
-  });
+  };
+  // The existing list is sorted; the added volumes mostly are too (one scan's are).
+  added_.clear();
+  for (const Volume& v : added) added_.push_back({v.bottom, v.top, v.mass});
+  if (!std::is_sorted(added_.begin(), added_.end(), before)) {
+    std::sort(added_.begin(), added_.end(), before);
+  }
+  std::size_t next_added = 0;
+  for (const Volume& v : existing) {
+    const Source s{v.bottom, v.top, v.mass};
+    while (next_added < added_.size() && before(added_[next_added], s)) {
+      sources_.push_back(added_[next_added++]);
+    }
+    sources_.push_back(s);
+  }
+  sources_.insert(sources_.end(), added_.begin() + static_cast<std::ptrdiff_t>(next_added),
+                  added_.end());
+  if (sources_.empty()) return;
   // With splitting, the obstacles that the free space reaches into join it (their heights are
   // its pieces), which may join runs that were apart: sweep until no new obstacle is reached.
   for (;;) {
     sweep();
-    if (!rules.split_at_obstacles) break;
+    if (!rules.split_at_obstacles || obstacles.size == 0) break;
     reached_.clear();
     std::size_t c = 0;
     for (const Volume& obstacle : obstacles) {
@@ -62,11 +75,14 @@ void ListMerger::merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles,
 void ListMerger::sweep() {
   // Upwards over the sources and the obstacles joined: overlaps join (eq. 7), gaps of at most
   // kMaxMergeGap are closed (eq. 8). Sorted by bottom, no later volume can reach into a gap once
-  // the sweep has passed it.
+  // the sweep has passed it. A gap eq. (8) fills is a stretch between sources that no source
+  // covers, at most kMaxMergeGap high (an obstacle bridging a wider one adds no free mass).
   components_.clear();
   gaps_.clear();
   std::size_t next_source = 0;
   std::size_t next_inside = 0;
+  float sources_top = 0.0f;  // top of the sources of the current component so far
+  bool has_source = false;
   while (next_source < sources_.size() || next_inside < inside_.size()) {
     const bool take_inside =
         next_inside < inside_.size() && (next_source == sources_.size() ||
@@ -75,16 +91,20 @@ void ListMerger::sweep() {
     const float top = take_inside ? inside_[next_inside].top : sources_[next_source].top;
     if (components_.empty() || !mustMerge(components_.back().top, bottom)) {
       components_.push_back({bottom, top, next_inside, next_inside});
+      has_source = false;
     } else {
-      Component& last = components_.back();
-      if (bottom > last.top) gaps_.push_back({last.top, bottom, 0.0});
-      last.top = std::max(last.top, top);
+      components_.back().top = std::max(components_.back().top, top);
     }
     if (take_inside) {
       components_.back().end_inside = ++next_inside;
-    } else {
-      ++next_source;
+      continue;
     }
+    if (has_source && bottom > sources_top && mustMerge(sources_top, bottom)) {
+      gaps_.push_back({sources_top, bottom, 0.0});
+    }
+    sources_top = has_source ? std::max(sources_top, top) : top;
+    has_source = true;
+    ++next_source;
   }
 }
 

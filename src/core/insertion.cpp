@@ -1,153 +1,49 @@
-// Insertion (Sec. III-B, Fig. 2): a scan is rasterised whole, its new volumes are collected per
-// column, then the constraints are applied once to every list it modified.
+// The second half of the scan update of Fig. 2: the constraints applied once to every list the
+// scan modified (Sec. III-B.3), with the model's rules (Sec. V.B, V.C).
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <unordered_map>
+#include <tuple>
 
+#include "map_storage.h"
 #include "mvog/constraints.h"
 #include "mvog/map.h"
-#include "mvog/raster.h"
+#include "scan_scratch.h"
 
 namespace mvog {
-
-bool Map::acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
-                        ReadingKind kind, const InsertionConfig& config, Eigen::Vector3d& ray_end,
-                        bool& obstacle, InsertionResult& result) const {
-  const bool is_obstacle = kind == ReadingKind::kObstacle;
-  if (!origin.allFinite() || !end.allFinite()) {
-    ++result.rejected_non_finite;
-    return false;
-  }
-  if (origin.cwiseAbs().maxCoeff() > config_.max_coordinate ||
-      end.cwiseAbs().maxCoeff() > config_.max_coordinate) {
-    ++result.rejected_out_of_bounds;
-    return false;
-  }
-  const Eigen::Vector3d ray = end - origin;
-  const double length = ray.norm();
-  // A zero-length out-of-range reading carries no free space; a zero-length hit is below any
-  // min_range but the sensor itself (decision: both are dropped as too close).
-  if (length == 0.0 || (is_obstacle && length < config.min_range)) {
-    ++result.rejected_too_close;
-    return false;
-  }
-  obstacle = is_obstacle && length <= config.max_range;
-  if (!obstacle && !config.insert_out_of_range) {
-    ++result.ignored_out_of_range;
-    return false;
-  }
-  ray_end =
-      length > config.max_range ? Eigen::Vector3d(origin + ray * (config.max_range / length)) : end;
-  if (obstacle) {
-    ++result.obstacle_readings;
-  } else {
-    ++result.out_of_range_readings;
-    if (is_obstacle) ++result.truncated_to_max_range;
-  }
-  return true;
-}
-
 namespace {
 
-std::uint64_t cellKey(const CellIndex& c) {
-  return (std::uint64_t{static_cast<std::uint32_t>(c.x)} << 32) | static_cast<std::uint32_t>(c.y);
-}
-CellIndex cellOfKey(std::uint64_t key) {
-  return {static_cast<std::int32_t>(key >> 32), static_cast<std::int32_t>(key)};
-}
+using detail::ScanInterval;
 
-/// A scan's new volumes in one list of one column, overlapping ones joined (eq. 7): sorted,
-/// disjoint, each with the summed mass of the volumes it joined.
-struct ScanInterval {
-  float bottom;
-  float top;
-  double mass;
+/// A run of volumes to change.
+struct VolumeSpan {
+  Volume* data;
+  std::uint32_t size;
+  Volume* begin() const { return data; }
+  Volume* end() const { return data + size; }
 };
 
-void addInterval(std::vector<ScanInterval>& list, const Volume& v) {
-  auto first = std::partition_point(list.begin(), list.end(),
-                                    [&](const ScanInterval& i) { return i.top < v.bottom; });
-  if (first == list.end() || first->bottom > v.top) {
-    list.insert(first, {v.bottom, v.top, v.mass});
-    return;
-  }
-  ScanInterval joined{std::min(v.bottom, first->bottom), v.top, v.mass};
-  auto last = first;
-  for (; last != list.end() && last->bottom <= v.top; ++last) {
-    joined.top = std::max(joined.top, last->top);
-    joined.mass += last->mass;
-  }
-  *first = joined;
-  list.erase(first + 1, last);
+/// The mass, in the map's stored unit, of the part [bottom, top] of a scan's interval: per scan,
+/// density 1 over the union of the heights seen; per reading (the paper), each reading's mass,
+/// kept in proportion where a part of the union is cut away.
+float massOf(const ScanInterval& i, float bottom, float top, bool per_scan, float unit_mass) {
+  const double height = static_cast<double>(top) - bottom;
+  const double mass = per_scan || (bottom == i.bottom && top == i.top)
+                          ? (per_scan ? height : i.mass)
+                          : i.mass * height / (static_cast<double>(i.top) - i.bottom);
+  return static_cast<float>(mass * unit_mass);
 }
 
-struct ScanColumn {
-  std::vector<ScanInterval> positive;
-  std::vector<ScanInterval> negative;
-};
-
-/// Sec. III-B.2: the volumes one reading creates, handed to emit(cell, sign, volume). `start`
-/// and `end` are in grid units.
-template <class Emit>
-void volumesOfReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
-                      bool model_negative_space, Emit&& emit) {
-  const float end_z = static_cast<float>(end.z());
-  auto obstacle_volume = [&] { return makeVolume(end_z - 0.5f, end_z + 0.5f); };
-  static const double margin = std::getenv("MVOG_MARGIN") ? std::atof(std::getenv("MVOG_MARGIN")) : 0.0;
-  if (obstacle && model_negative_space && margin > 0.0) {
-    const Eigen::Vector3d ray = end - start;
-    const double length = ray.norm();
-    if (length > margin) {
-      const Eigen::Vector3d free_end = start + ray * ((length - margin) / length);
-      walkRay(start.x(), start.y(), start.z(), free_end.x(), free_end.y(), free_end.z(),
-              [&](const CellIndex& cell, double z_enter, double z_exit, bool) {
-                emit(cell, VolumeSign::kNegative,
-                     makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
-              });
-    }
-    emit(cellAt(end.x(), end.y()), VolumeSign::kPositive, obstacle_volume());
-    return;
-  }
-  if (!model_negative_space) {
-    // Only the obstacle's own volume, in the cell the walk would end in (see walkRay): no walk.
-    if (obstacle) emit(cellAt(end.x(), end.y()), VolumeSign::kPositive, obstacle_volume());
-    return;
-  }
-  walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
-          [&](const CellIndex& cell, double z_enter, double z_exit, bool is_last) {
-            if (!is_last || !obstacle) {  // eqs. (3) and (4)
-              emit(cell, VolumeSign::kNegative,
-                   makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
-              return;
-            }
-            const Volume positive = obstacle_volume();  // eq. (5)
-            emit(cell, VolumeSign::kPositive, positive);
-            if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
-              emit(cell, VolumeSign::kNegative,
-                   makeVolume(static_cast<float>(z_enter),
-                              z_enter < end.z() ? positive.bottom : positive.top));
-            }
-          });
-}
-
-/// The new volumes of one column, as the model's rules make them from what the scan saw there.
-void addedVolumes(const ScanColumn& column, const ModelRules& rules, float unit_mass,
-                  CellVolumes& added) {
+/// The new volumes of one column, as the model's rules make them from what one scan saw there
+/// (`free` and `hits`: sorted, disjoint), masses in the map's stored unit.
+void addedVolumes(const std::vector<ScanInterval>& free, const std::vector<ScanInterval>& hits,
+                  const ModelRules& rules, float unit_mass, CellVolumes& added) {
   added.positive.clear();
   added.negative.clear();
   const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
   auto mass_of = [&](const ScanInterval& i, float bottom, float top) {
-    const double height = static_cast<double>(top) - bottom;
-    return static_cast<float>(
-        (per_scan ? height : i.mass * height / (static_cast<double>(i.top) - i.bottom)) *
-        unit_mass);
+    return massOf(i, bottom, top, per_scan, unit_mass);
   };
-  for (const ScanInterval& i : column.positive) {
-    added.positive.push_back({i.bottom, i.top, mass_of(i, i.bottom, i.top)});
-  }
-  for (const ScanInterval& i : column.negative) {
+  for (const ScanInterval& i : hits) added.positive.push_back({i.bottom, i.top, mass_of(i, i.bottom, i.top)});
+  for (const ScanInterval& i : free) {
     if (!rules.clip_free_space_at_hits) {
       added.negative.push_back({i.bottom, i.top, mass_of(i, i.bottom, i.top)});
       continue;
@@ -156,11 +52,9 @@ void addedVolumes(const ScanColumn& column, const ModelRules& rules, float unit_
     // lower than kMinVolumeHeight (a sliver beside a hit) is dropped.
     float below = i.bottom;
     auto keep = [&](float bottom, float top) {
-      if (top - bottom >= kMinVolumeHeight) {
-        added.negative.push_back({bottom, top, mass_of(i, bottom, top)});
-      }
+      if (top - bottom >= kMinVolumeHeight) added.negative.push_back({bottom, top, mass_of(i, bottom, top)});
     };
-    for (const ScanInterval& hit : column.positive) {
+    for (const ScanInterval& hit : hits) {
       if (hit.top <= below) continue;
       if (hit.bottom >= i.top) break;
       keep(below, std::min(hit.bottom, i.top));
@@ -172,62 +66,282 @@ void addedVolumes(const ScanColumn& column, const ModelRules& rules, float unit_
 
 }  // namespace
 
+/// One thread's working memory while applying a scan.
+struct ColumnWork {
+  ListMerger merger;
+  detail::TileBlock::Builder builder;
+  /// The scratches that reached the tile being updated, and their part of it.
+  std::vector<std::pair<const detail::ScanScratch*, const detail::ScratchTile*>> parts;
+  std::vector<detail::TileHit> hits;                       // the tile's, by cell
+  std::uint32_t hits_per_cell[detail::kCellsPerTile + 1];  // where each cell's start in hits
+  std::vector<ScanInterval> free;
+  std::vector<ScanInterval> positive;
+  CellVolumes added;
+  CellVolumes merged;
+  std::vector<Volume> existing_positive;
+  std::vector<Volume> existing_negative;
+  /// The new lists of the tile's cells that the scan reached: volumes[start, start + positive)
+  /// and then its negative ones; and whether each keeps the length of its lists.
+  struct CellResult {
+    unsigned local;
+    std::size_t start;
+    std::uint32_t num_positive;
+    std::uint32_t num_negative;
+  };
+  std::vector<CellResult> results;
+  std::vector<Volume> volumes;
+  CellRange grown = kNoCells;  // cells that received their first volume
+};
+
+namespace {
+
+/// Gathers what the scan's scratches hold for tile `key`: its parts, and its hits by cell.
+void gatherTile(std::uint64_t key, const std::vector<detail::ScanScratch>& scratches,
+                ColumnWork& work) {
+  work.parts.clear();
+  // The hits by cell (a counting sort), each cell's sorted by height.
+  std::fill(std::begin(work.hits_per_cell), std::end(work.hits_per_cell), 0u);
+  std::size_t num_hits = 0;
+  for (const detail::ScanScratch& scratch : scratches) {
+    if (const detail::ScratchTile* part = scratch.find(key)) {
+      work.parts.emplace_back(&scratch, part);
+      for (const detail::TileHit& hit : part->hits) ++work.hits_per_cell[hit.local + 1];
+      num_hits += part->hits.size();
+    }
+  }
+  for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
+    work.hits_per_cell[local + 1] += work.hits_per_cell[local];
+  }
+  work.hits.resize(num_hits);
+  std::uint32_t next[detail::kCellsPerTile];
+  std::copy(work.hits_per_cell, work.hits_per_cell + detail::kCellsPerTile, next);
+  for (const auto& part : work.parts) {
+    for (const detail::TileHit& hit : part.second->hits) work.hits[next[hit.local]++] = hit;
+  }
+  auto lower = [](const detail::TileHit& a, const detail::TileHit& b) {
+    return std::tie(a.bottom, a.top) < std::tie(b.bottom, b.top);
+  };
+  for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
+    const auto first = work.hits.begin() + work.hits_per_cell[local];
+    const auto last = work.hits.begin() + work.hits_per_cell[local + 1];
+    if (last - first > 1 && !std::is_sorted(first, last, lower)) std::sort(first, last, lower);
+  }
+}
+
+/// What the scan saw in cell `local`: its free intervals and its hits, each joined.
+void scanColumn(unsigned local, float join_gap, ColumnWork& work) {
+  work.free.clear();
+  for (const auto& [scratch, part] : work.parts) scratch->appendFree(*part, local, work.free);
+  if (work.parts.size() > 1) {
+    // Each thread's part is joined already; join the parts. The masses are exact sums
+    // (ScanInterval), so the union is the same as one thread's, bit for bit.
+    std::sort(work.free.begin(), work.free.end(), [](const ScanInterval& a, const ScanInterval& b) {
+      return std::tie(a.bottom, a.top, a.mass) < std::tie(b.bottom, b.top, b.mass);
+    });
+    detail::joinSorted(work.free, join_gap);
+  }
+  work.positive.clear();
+  for (std::uint32_t h = work.hits_per_cell[local]; h < work.hits_per_cell[local + 1]; ++h) {
+    const detail::TileHit& hit = work.hits[h];
+    const double mass = static_cast<double>(hit.top) - hit.bottom;  // density 1 (eq. 5)
+    if (!work.positive.empty() && detail::joins(work.positive.back().top, hit.bottom, join_gap)) {
+      work.positive.back().top = std::max(work.positive.back().top, hit.top);
+      work.positive.back().mass += mass;
+    } else {
+      work.positive.push_back({hit.bottom, hit.top, mass});
+    }
+  }
+}
+
+/// The commonest update by far once a place has been seen: free space where the column already
+/// holds free space, and no hit. The lists keep their volumes and bounds; each negative volume
+/// gains the mass that falls within it (what ListMerger gives: no gap closes, no obstacle is
+/// newly reached, so its pieces stay). Returns false, changing nothing, in any other case.
+bool addCoveredFreeSpace(const std::vector<Volume>& added, Volume* negative,
+                         std::uint32_t num_negative) {
+  if (num_negative == 0) return false;
+  // Every added volume lies within one run of touching negative volumes.
+  for (const Volume& a : added) {
+    std::uint32_t k = 0;
+    while (k < num_negative && negative[k].top < a.bottom) ++k;
+    if (k == num_negative || negative[k].bottom > a.bottom) return false;
+    while (negative[k].top < a.top) {
+      if (k + 1 == num_negative || negative[k + 1].bottom != negative[k].top) return false;
+      ++k;
+    }
+  }
+  for (Volume& v : VolumeSpan{negative, num_negative}) {
+    double mass = v.mass;
+    for (const Volume& a : added) {
+      if (a.bottom >= v.top) break;
+      if (a.bottom >= v.bottom && a.top <= v.top) {
+        mass += a.mass;
+        continue;
+      }
+      const double overlap =
+          static_cast<double>(std::min(v.top, a.top)) - std::max(v.bottom, a.bottom);
+      if (overlap > 0.0) mass += a.mass * overlap / (static_cast<double>(a.top) - a.bottom);
+    }
+    v.mass = static_cast<float>(mass);
+  }
+  return true;
+}
+
+/// Merges the new volumes of the scan's scratches into the columns of tile `key`.
+void updateTile(detail::TileBlock& tile, std::uint64_t key,
+                const std::vector<detail::ScanScratch>& scratches, const ModelRules& rules,
+                float unit_mass, double rescale, std::int32_t exponent, std::uint64_t revision,
+                ColumnWork& work) {
+  gatherTile(key, scratches, work);
+  // The tile was written before a decay step: bring its masses to the current unit first.
+  if (rescale != 1.0) tile.scaleMasses(rescale, exponent);
+  work.results.clear();
+  work.volumes.clear();
+  const CellIndex origin = detail::tileOrigin(key);
+  const FreeSpaceRules free_space_rules{rules.split_free_space_at_obstacles,
+                                        rules.clip_free_space_at_hits};
+  const float join_gap = detail::joinGapOf(rules);
+  const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
+  unsigned rank = 0;  // of the next cell holding volumes
+  for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
+    const bool held = tile.holds(local);
+    const unsigned cell_rank = rank;
+    rank += held ? 1 : 0;
+    const bool has_hits = work.hits_per_cell[local + 1] > work.hits_per_cell[local];
+    if (!has_hits && std::none_of(work.parts.begin(), work.parts.end(), [&](const auto& part) {
+          return part.first->reached(*part.second, local);
+        })) {
+      continue;
+    }
+    const detail::ColumnRef existing = held ? tile.columnAtRank(cell_rank) : detail::ColumnRef{};
+    // The tile's own storage of this cell, changed in place where the lengths stay.
+    Volume* stored = const_cast<Volume*>(existing.positive);
+    ScanInterval single;
+    if (!has_hits && held && work.parts.size() == 1 &&
+        work.parts[0].first->singleFree(*work.parts[0].second, local, single)) {
+      // The commonest case without a vector in between: one free interval, no hit.
+      work.added.negative.assign(
+          1, Volume{single.bottom, single.top,
+                    massOf(single, single.bottom, single.top, per_scan, unit_mass)});
+      if (addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
+                              existing.num_negative)) {
+        continue;
+      }
+    }
+    scanColumn(local, join_gap, work);
+    addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
+    if (work.added.positive.empty() &&
+        addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
+                            existing.num_negative)) {
+      continue;
+    }
+    work.existing_positive.assign(existing.positive, existing.positive + existing.num_positive);
+    work.existing_negative.assign(existing.negative, existing.negative + existing.num_negative);
+    if (work.added.positive.empty()) {
+      work.merged.positive = work.existing_positive;
+    } else {
+      work.merger.merge(work.existing_positive, work.added.positive, {}, {}, unit_mass,
+                        work.merged.positive);
+    }
+    work.merger.merge(work.existing_negative, work.added.negative, work.merged.positive,
+                      free_space_rules, unit_mass, work.merged.negative);
+    const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
+    const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());
+    if (held && num_positive == existing.num_positive && num_negative == existing.num_negative) {
+      // Mostly every list keeps its length (new volumes merge into those there).
+      std::copy(work.merged.positive.begin(), work.merged.positive.end(), stored);
+      std::copy(work.merged.negative.begin(), work.merged.negative.end(), stored + num_positive);
+      continue;
+    }
+    work.results.push_back({local, work.volumes.size(), num_positive, num_negative});
+    work.volumes.insert(work.volumes.end(), work.merged.positive.begin(), work.merged.positive.end());
+    work.volumes.insert(work.volumes.end(), work.merged.negative.begin(), work.merged.negative.end());
+    if (existing.empty() && num_positive + num_negative > 0) {
+      work.grown.extend(CellIndex{origin.x + static_cast<std::int32_t>(local % detail::kTileSize),
+                                  origin.y + static_cast<std::int32_t>(local / detail::kTileSize)});
+    }
+  }
+  if (work.results.empty()) {
+    tile.setModifiedRevision(revision);
+    return;
+  }
+  // Some list changed its length: the tile is built anew, its other cells copied.
+  auto result = work.results.begin();
+  rank = 0;
+  for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
+    const bool held = tile.holds(local);
+    const detail::ColumnRef existing = held ? tile.columnAtRank(rank++) : detail::ColumnRef{};
+    if (result != work.results.end() && result->local == local) {
+      if (result->num_positive + result->num_negative > 0) {
+        const Volume* v = work.volumes.data() + result->start;
+        work.builder.add(local, {v, result->num_positive, v + result->num_positive,
+                                 result->num_negative},
+                         1.0);
+      }
+      ++result;
+    } else if (held) {
+      work.builder.add(local, existing, 1.0);
+    }
+  }
+  tile = work.builder.finish(exponent, revision);
+}
+
+}  // namespace
+
+InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config) {
+  if (own_update_ == nullptr) own_update_ = std::make_unique<ScanUpdate>();
+  own_update_->prepare(scan, config_, config);
+  return apply(*own_update_);
+}
+
 InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
                                    ReadingKind kind, const InsertionConfig& config) {
   Scan scan;
   scan.origin = origin;
-  const Eigen::Vector3f end_f = end.cast<float>();
-  (kind == ReadingKind::kObstacle ? scan.hits : scan.out_of_range).push_back(end_f);
+  (kind == ReadingKind::kObstacle ? scan.hits : scan.out_of_range).push_back(end.cast<float>());
   return insertScan(scan, config);
 }
 
-InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config) {
-  config.validate();
-  InsertionResult result;
-  std::unordered_map<std::uint64_t, ScanColumn> columns;
-  const Eigen::Vector3d start = scan.origin * scale_inverse_;
-  auto accept = [&](const Eigen::Vector3f& end, ReadingKind kind) {
-    Eigen::Vector3d ray_end;
-    bool obstacle = false;
-    if (!acceptReading(scan.origin, end.cast<double>(), kind, config, ray_end, obstacle, result)) {
-      return;
-    }
-    volumesOfReading(start, ray_end * scale_inverse_, obstacle, config.model_negative_space,
-                     [&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
-                       ScanColumn& column = columns[cellKey(cell)];
-                       addInterval(
-                           sign == VolumeSign::kPositive ? column.positive : column.negative,
-                           volume);
-                     });
-  };
-  for (const Eigen::Vector3f& hit : scan.hits) accept(hit, ReadingKind::kObstacle);
-  for (const Eigen::Vector3f& end : scan.out_of_range) accept(end, ReadingKind::kOutOfRange);
-  if (columns.empty()) return result;
-
-  ListMerger merger;
-  CellVolumes added;
-  CellVolumes merged;
-  for (const auto& [key, column] : columns) {
-    const CellIndex cell = cellOfKey(key);
-    addedVolumes(column, config_.rules, 1.0f, added);
-    const CellVolumes existing = cellVolumes(cell);
-    merger.merge(existing.positive, added.positive, {}, {}, 1.0f, merged.positive);
-    merger.merge(existing.negative, added.negative, merged.positive,
-                 {config_.rules.split_free_space_at_obstacles, config_.rules.clip_free_space_at_hits},
-                 1.0f, merged.negative);
-    try { setCellVolumes(cell, merged); } catch (const ConfigError& e) {
-      auto dump = [](const char* name, const std::vector<Volume>& l) {
-        std::fprintf(stderr, "%s:", name);
-        for (const Volume& v : l) std::fprintf(stderr, " [%.9g, %.9g | %.6g]", v.bottom, v.top, v.mass);
-        std::fprintf(stderr, "\n");
-      };
-      dump("existing P", existing.positive); dump("existing N", existing.negative);
-      dump("added P", added.positive); dump("added N", added.negative);
-      dump("merged P", merged.positive); dump("merged N", merged.negative);
-      throw;
-    }
+InsertionResult Map::apply(ScanUpdate& update) {
+  ScanUpdate::Impl& impl = *update.impl_;
+  if (impl.map_config.resolution != config_.resolution ||
+      impl.map_config.max_coordinate != config_.max_coordinate ||
+      !(impl.map_config.rules == config_.rules)) {
+    throw ConfigError("update: prepared for another map configuration");
   }
-  return result;
+  std::vector<std::uint64_t> keys;
+  for (const detail::ScanScratch& scratch : impl.scratches) {
+    for (const auto& entry : scratch.tiles()) keys.push_back(entry.first);
+  }
+  if (keys.empty()) return impl.result;
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  ++revision_;
+  // Every tile the scan reaches exists before the threads start: they then only write the
+  // tiles they are given, and never change the index.
+  std::vector<detail::TileBlock*> tiles(keys.size());
+  for (std::size_t k = 0; k < keys.size(); ++k) tiles[k] = &storage_->tiles[keys[k]];
+
+  const float unit_mass = static_cast<float>(1.0 / mass_unit_);
+  const auto exponent = static_cast<std::int32_t>(unit_exponent_);
+  const std::size_t num_threads = impl.scratches.size();
+  std::vector<ColumnWork> work(num_threads);
+  auto update_tile = [&](std::size_t worker, std::size_t k) {
+    detail::TileBlock& tile = *tiles[k];
+    const double rescale = tile.empty() ? 1.0 : rescaleOf(tile.exponent());
+    updateTile(tile, keys[k], impl.scratches, config_.rules, unit_mass, rescale, exponent,
+               revision_, work[worker]);
+  };
+  if (detail::ThreadPool* pool = impl.threads(num_threads)) {
+    pool->run(keys.size(), update_tile);
+  } else {
+    for (std::size_t k = 0; k < keys.size(); ++k) update_tile(0, k);
+  }
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    if (tiles[k]->empty()) storage_->tiles.erase(keys[k]);
+  }
+  for (const ColumnWork& w : work) bounds_.extend(w.grown);
+  return impl.result;
 }
 
 }  // namespace mvog

@@ -1,15 +1,22 @@
-// Insertion of readings and scans (Sec. III-B): eqs. (3)-(6) on the rays of Fig. 3, the
-// InsertionConfig options, scan insertion with threads, the Sec. V.B option, and the Sec. III-A
-// invariants after many random readings.
+// Insertion of readings and scans (Sec. III-B, Fig. 2): eqs. (3)-(6) on the rays of Fig. 3 with
+// the paper's model, the InsertionConfig options, the scan update (order and threads do not
+// matter, the two phases), the model's rules (Sec. V.B, V.C, counting per scan) against a plain
+// reference implementation, and the Sec. III-A invariants after many random readings.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <random>
+#include <sstream>
+#include <string>
 #include <vector>
 
+#include "mvog/constraints.h"
 #include "mvog/map.h"
+#include "mvog/scan_update.h"
+#include "reference_model.h"
 #include "test_util.h"
 
 namespace mvog {
@@ -150,7 +157,7 @@ TEST(Insertion, VerticalRays) {
 
 TEST(Insertion, HorizontalRayMakesUnitVolumesAroundItsHeight) {
   // A horizontal ray crosses every cell at one height z: eq. (6) gives [z - 0.5, z + 0.5].
-  Map map(MapConfig{0.5, 1000.0});
+  Map map(MapConfig{0.5, 1000.0, ModelRules::paper()});
   map.insertReading({0.1, 0.1, 1.0}, {2.1, 0.1, 1.0},
                     ReadingKind::kObstacle);  // grid: x 0.2 -> 4.2, z = 2
   for (int i = 0; i < 4; ++i) {
@@ -201,7 +208,7 @@ TEST(Insertion, RandomReadingsKeepTheInvariants) {
   // Thousands of random readings, one at a time: every list keeps the Sec. III-A constraints,
   // and the total mass grows by at least 1 per reading (every reading creates at least one
   // volume, of height >= 1 at density 1, and masses only ever add up).
-  Map map(MapConfig{0.5, 1000.0});
+  Map map(MapConfig{0.5, 1000.0, ModelRules::paper()});
   std::mt19937 rng(2024);
   std::bernoulli_distribution is_obstacle(0.7);
   double previous_total = 0.0;
@@ -373,58 +380,23 @@ TEST(Insertion, ResultCountsEveryReadingOnce) {
   EXPECT_EQ(sum.ignored_out_of_range, 3u);
 }
 
-// ---- Scans -------------------------------------------------------------------------------------
-
-TEST(Insertion, ScanEqualsReadingByReading) {
-  MapConfig map_config;
-  map_config.resolution = 0.25;  // +-30 m: 240 cells, 15 tiles across, around the origin
-  Map by_scan(map_config);
-  Map by_reading(map_config);
-  std::mt19937 rng(11);
-  InsertionConfig config;
-  config.max_range = 25.0;
-  config.min_range = 0.2;
-  for (const Eigen::Vector3d& origin :
-       {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(-7, 5, 1)}) {
-    const Scan scan = test::randomScan(rng, origin, 2000, 1000, 30.0);
-    const InsertionResult scan_result = by_scan.insertScan(scan, config);
-    InsertionResult reading_result;
-    for (const Eigen::Vector3f& hit : scan.hits) {
-      reading_result +=
-          by_reading.insertReading(origin, hit.cast<double>(), ReadingKind::kObstacle, config);
-    }
-    for (const Eigen::Vector3f& end : scan.out_of_range) {
-      reading_result +=
-          by_reading.insertReading(origin, end.cast<double>(), ReadingKind::kOutOfRange, config);
-    }
-    EXPECT_EQ(scan_result.obstacle_readings, reading_result.obstacle_readings);
-    EXPECT_EQ(scan_result.out_of_range_readings, reading_result.out_of_range_readings);
-    EXPECT_EQ(scan_result.truncated_to_max_range, reading_result.truncated_to_max_range);
-    EXPECT_EQ(scan_result.rejected(), reading_result.rejected());
-    EXPECT_GT(scan_result.truncated_to_max_range, 0u);
-  }
-  EXPECT_TRUE(test::sameVolumes(allVolumes(by_scan), allVolumes(by_reading)));
-  EXPECT_EQ(by_scan.bounds().min, by_reading.bounds().min);
-  EXPECT_EQ(by_scan.bounds().max, by_reading.bounds().max);
-  EXPECT_LT(by_scan.bounds().min.x, 0);
-  EXPECT_LT(by_scan.bounds().min.y, 0);
-}
+// ---- The scan update (Fig. 2) ------------------------------------------------------------------
 
 TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
-  // Vertical readings reach one cell each, so what each cell must hold follows from makeVolume
-  // and insertVolume alone (Sec. III-B.2: an obstacle's positive volume, then the padding below
-  // or above it; free space from the start to the end of an out-of-range reading). Many readings
-  // into 2 x 2 cells make both lists of each cell grow, merge, shrink and grow again, which the
-  // map does in one block per cell, with fast paths for the common merges and masses rescaled
-  // after decay: the map must hold exactly the lists that the rules give, bit for bit, every step
-  // of the way.
+  // Vertical readings reach one cell each, so with the paper's model what each cell must hold
+  // follows from makeVolume and the list rules alone (Sec. III-B.2: an obstacle's positive
+  // volume, then the padding below or above it; free space from the start to the end of an
+  // out-of-range reading). Many readings into 2 x 2 cells make both lists of each cell grow,
+  // merge, shrink and grow again, which the map does in tiles written in place or rebuilt, with
+  // masses rescaled after decay: it must hold exactly the lists the rules give, bit for bit.
   Map map(unitConfig());
   std::vector<std::vector<Volume>> positive(4);
   std::vector<std::vector<Volume>> negative(4);
-  auto insert_into = [](std::vector<Volume>& list, const Volume& volume) {
-    list.push_back({});
-    const auto count = static_cast<std::uint32_t>(list.size() - 1);
-    list.resize(insertVolume(list.data(), count, volume, 1.0f));
+  ListMerger merger;
+  auto insert_into = [&](std::vector<Volume>& list, const Volume& volume) {
+    std::vector<Volume> out;
+    merger.merge(list, VolumeRun(&volume, 1), {}, {}, 1.0f, out);
+    list = out;
   };
   // Short rays at one of 8 levels 12 apart: volumes of one level merge, different levels stay
   // apart, so the lists hold up to 8 volumes and a volume bridging two of a level shrinks them.
@@ -440,7 +412,7 @@ TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
     const double x = (c % 2) + 0.5;
     const double y = (c / 2) + 0.5;
     // The first readings stay on one level, so that columns hold one free-space volume for a
-    // while (the map's commonest case, which it merges without searching the list).
+    // while (the commonest case, which the map updates in place).
     const int level = step < 400 ? 0 : level_of(rng);
     const double z0 = 12.0 * level + quarters(rng) / 4.0;
     const double length = length_in_eighths(rng) / 8.0;
@@ -451,13 +423,13 @@ TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
     const auto start_z = static_cast<float>(z0);
     const auto end_z = static_cast<float>(z1);
     if (obstacle) {
-      const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f, 1.0f);
+      const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
       insert_into(positive[c], hit);
       if (std::fabs(z0 - z1) > 1.0) {
-        insert_into(negative[c], makeVolume(start_z, z0 < z1 ? hit.bottom : hit.top, 1.0f));
+        insert_into(negative[c], makeVolume(start_z, z0 < z1 ? hit.bottom : hit.top));
       }
     } else {
-      insert_into(negative[c], makeVolume(start_z, end_z, 1.0f));
+      insert_into(negative[c], makeVolume(start_z, end_z));
     }
     const CellVolumes held = map.cellVolumes({c % 2, c / 2});
     auto same = [](const std::vector<Volume>& a, const std::vector<Volume>& b) {
@@ -470,7 +442,7 @@ TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
         << "negative list of cell " << c << ", step " << step;
     if (step % 500 == 499) {
       // Decay by 1/2: exact in float, so the rules' masses halve exactly too (Sec. III-E), and
-      // the map rescales a cell's masses when it next writes to it.
+      // the map rescales a tile's masses when it next writes to it.
       map.decay(0.5);
       for (auto* lists : {&positive, &negative}) {
         for (std::vector<Volume>& list : *lists) {
@@ -489,74 +461,73 @@ TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
   EXPECT_GE(most_negative, 2u);
 }
 
-TEST(Insertion, SplitScanPiecesInsertedInOrderBuildTheSameMap) {
-  MapConfig map_config;
-  map_config.resolution = 0.25;
-  std::mt19937 rng(5);
-  const Scan scan = test::randomScan(rng, {0.5, -1.0, 0.25}, 2000, 1000, 20.0);
-  // 700 does not divide 2000: one piece holds the last hits and the first free endpoints.
-  const std::vector<Scan> pieces = splitScan(scan, 700);
-  ASSERT_EQ(pieces.size(), 5u);
-  std::vector<Eigen::Vector3f> hits;
-  std::vector<Eigen::Vector3f> out_of_range;
-  for (const Scan& piece : pieces) {
-    EXPECT_EQ(piece.origin, scan.origin);
-    EXPECT_LE(piece.hits.size() + piece.out_of_range.size(), 700u);
-    hits.insert(hits.end(), piece.hits.begin(), piece.hits.end());
-    out_of_range.insert(out_of_range.end(), piece.out_of_range.begin(), piece.out_of_range.end());
-  }
-  EXPECT_EQ(pieces[2].hits.size(), 600u);
-  EXPECT_EQ(pieces[2].out_of_range.size(), 100u);
-  EXPECT_EQ(hits, scan.hits);
-  EXPECT_EQ(out_of_range, scan.out_of_range);
-
-  Map whole(map_config);
-  Map piece_by_piece(map_config);
-  InsertionConfig config;
-  config.max_range = 15.0;
-  const InsertionResult whole_result = whole.insertScan(scan, config);
-  InsertionResult pieces_result;
-  for (const Scan& piece : pieces) pieces_result += piece_by_piece.insertScan(piece, config);
-  EXPECT_EQ(pieces_result.obstacle_readings, whole_result.obstacle_readings);
-  EXPECT_EQ(pieces_result.out_of_range_readings, whole_result.out_of_range_readings);
-  EXPECT_EQ(pieces_result.rejected(), whole_result.rejected());
-  EXPECT_TRUE(test::sameVolumes(allVolumes(piece_by_piece), allVolumes(whole)));
+/// The model's rules the properties below hold for: the paper's, the defaults, and each
+/// default rule alone.
+std::vector<ModelRules> everyRuleSet() {
+  std::vector<ModelRules> sets{ModelRules::paper(), ModelRules{}};
+  ModelRules clip = ModelRules::paper();
+  clip.clip_free_space_at_hits = true;
+  ModelRules per_scan = ModelRules::paper();
+  per_scan.mass_counting = MassCounting::kPerScan;
+  ModelRules split = ModelRules::paper();
+  split.split_free_space_at_obstacles = true;
+  sets.insert(sets.end(), {clip, per_scan, split});
+  return sets;
 }
 
-TEST(Insertion, SplitScanEdgeCases) {
-  EXPECT_TRUE(splitScan(Scan{}, 10).empty());
-  Scan scan;
-  scan.out_of_range.assign(3, Eigen::Vector3f(1, 2, 3));
-  const std::vector<Scan> pieces = splitScan(scan, 1);
-  ASSERT_EQ(pieces.size(), 3u);
-  EXPECT_TRUE(pieces[0].hits.empty());
-  EXPECT_EQ(pieces[0].out_of_range.size(), 1u);
-  EXPECT_THROW(splitScan(scan, 0), ConfigError);
+std::string describe(const ModelRules& rules) {
+  std::ostringstream text;
+  text << "clip " << rules.clip_free_space_at_hits << ", per scan "
+       << (rules.mass_counting == MassCounting::kPerScan) << ", split "
+       << rules.split_free_space_at_obstacles;
+  return text.str();
+}
+
+/// Scans from a few origins over about 8 x 8 tiles, with hits near each other (so that columns
+/// receive hits and free space of the same scan) and far.
+std::vector<Scan> testScans(unsigned seed) {
+  std::mt19937 rng(seed);
+  return {test::randomScan(rng, {0.0, 0.0, 0.0}, 5000, 1500, 12.0),
+          test::randomScan(rng, {-5.5, 3.25, 1.0}, 1500, 500, 4.0),
+          test::randomScan(rng, {4.0, -3.0, -1.0}, 1500, 500, 12.0),
+          test::randomScan(rng, {0.2, 0.1, 0.3}, 3000, 0, 3.0)};
+}
+
+TEST(Insertion, TheMapDependsOnTheSetOfReadingsNotTheirOrder) {
+  MapConfig map_config;
+  map_config.resolution = 0.25;
+  for (const ModelRules& rules : everyRuleSet()) {
+    SCOPED_TRACE(describe(rules));
+    map_config.rules = rules;
+    Map in_order(map_config);
+    Map shuffled(map_config);
+    std::mt19937 rng(3);
+    for (Scan scan : testScans(21)) {
+      in_order.insertScan(scan);
+      std::shuffle(scan.hits.begin(), scan.hits.end(), rng);
+      std::shuffle(scan.out_of_range.begin(), scan.out_of_range.end(), rng);
+      shuffled.insertScan(scan);
+    }
+    EXPECT_TRUE(test::sameVolumes(allVolumes(shuffled), allVolumes(in_order)));
+    EXPECT_TRUE(test::mapSatisfiesConstraints(in_order));
+  }
 }
 
 TEST(Insertion, ThreadsBuildTheSameMap) {
-  // A scan of 9000 readings (more than one internal chunk of 8192) and two smaller ones, over
-  // about 8 x 8 tiles around the origin, into maps built with 1 to 4 threads: identical volumes,
-  // bit for bit.
+  // Scans into maps built with 1 to 4 threads: identical volumes, bit for bit.
   MapConfig map_config;
   map_config.resolution = 0.25;
-  std::mt19937 rng(99);
-  const std::vector<Scan> scans{test::randomScan(rng, {0.0, 0.0, 0.0}, 7000, 2000, 12.0),
-                                test::randomScan(rng, {-5.5, 3.25, 1.0}, 1500, 500, 12.0),
-                                test::randomScan(rng, {4.0, -3.0, -1.0}, 1500, 500, 12.0)};
-  for (bool clear_conflicts : {false, true}) {
-    SCOPED_TRACE(clear_conflicts ? "clearing conflicting free space" : "plain");
+  const std::vector<Scan> scans = testScans(99);
+  for (const ModelRules& rules : {ModelRules::paper(), ModelRules{}}) {
+    SCOPED_TRACE(describe(rules));
+    map_config.rules = rules;
     std::vector<std::vector<test::VolumeRecord>> maps;
     std::vector<CellRange> bounds;
     for (int threads = 1; threads <= 4; ++threads) {
       Map map(map_config);
       InsertionConfig config;
       config.insertion_threads = threads;
-      config.clear_conflicting_free_space = clear_conflicts;
       for (const Scan& scan : scans) map.insertScan(scan, config);
-      if (threads == 1) {
-        EXPECT_TRUE(test::mapSatisfiesConstraints(map));
-      }
       maps.push_back(allVolumes(map));
       bounds.push_back(map.bounds());
     }
@@ -570,67 +541,232 @@ TEST(Insertion, ThreadsBuildTheSameMap) {
   }
 }
 
-// ---- Sec. V.B: clear_conflicting_free_space -----------------------------------------------------
-
-TEST(Insertion, ConflictingFreeSpaceOfTheSameScanIsDropped) {
-  Scan scan;
-  scan.origin = {0.5, 0.5, 0.5};
-  scan.hits.push_back({5.5f, 0.5f, 0.5f});  // A: positive [0, 1] in cell (5, 0)
-  scan.hits.push_back({8.5f, 0.5f, 0.5f});  // B: crosses cell (5, 0) at z = 0.5: [0, 1] there
-  scan.out_of_range.push_back({9.5f, 0.5f, 9.5f});  // C: crosses cell (5, 0) at z in [5, 6]
-  for (bool clear_conflicts : {false, true}) {
-    SCOPED_TRACE(clear_conflicts ? "clearing" : "not clearing");
-    Map map(unitConfig());
-    InsertionConfig config;
-    config.clear_conflicting_free_space = clear_conflicts;
-    map.insertScan(scan, config);
-    const CellVolumes cell = map.cellVolumes({5, 0});
-    ASSERT_EQ(cell.positive.size(), 1u);
-    EXPECT_TRUE(volumeIs(cell.positive[0], 0.0, 1.0, 1.0));
-    // C's free space does not overlap A's obstacle: kept either way.
-    ASSERT_EQ(cell.negative.size(), clear_conflicts ? 1u : 2u);
-    EXPECT_TRUE(volumeIs(cell.negative.back(), 5.0, 6.0, 1.0));
-    if (!clear_conflicts) {
-      EXPECT_TRUE(volumeIs(cell.negative.front(), 0.0, 1.0, 1.0));
+TEST(Insertion, AReadingIsTheScanOfOneReading) {
+  for (const ModelRules& rules : everyRuleSet()) {
+    SCOPED_TRACE(describe(rules));
+    Map by_reading(unitConfig(10000.0, rules));
+    Map by_scan(unitConfig(10000.0, rules));
+    std::mt19937 rng(8);
+    for (int k = 0; k < 300; ++k) {
+      const Eigen::Vector3d origin = test::randomPoint(rng, 10.0, 2.0);
+      const Eigen::Vector3f end = test::randomPoint(rng, 10.0, 2.0).cast<float>();
+      const bool obstacle = k % 3 != 0;
+      by_reading.insertReading(origin, end.cast<double>(),
+                               obstacle ? ReadingKind::kObstacle : ReadingKind::kOutOfRange);
+      Scan scan;
+      scan.origin = origin;
+      (obstacle ? scan.hits : scan.out_of_range).push_back(end);
+      by_scan.insertScan(scan);
     }
-    // Cells without a positive volume of this scan keep all their free space.
-    EXPECT_EQ(map.cellVolumes({4, 0}).negative.size(), 2u);
-    EXPECT_EQ(map.cellVolumes({7, 0}).negative.size(), 2u);
-    // B's own obstacle is kept.
-    EXPECT_EQ(map.cellVolumes({8, 0}).positive.size(), 1u);
+    EXPECT_TRUE(test::sameVolumes(allVolumes(by_reading), allVolumes(by_scan)));
   }
 }
 
-TEST(Insertion, FreeSpaceTouchingAnObstacleIsNoConflict) {
-  // A steep hit straight up: V = [4.5, 5.5] and its padding [0.5, 4.5] touch at 4.5 without
-  // overlapping, so the padding is kept.
-  Scan scan;
-  scan.origin = {0.5, 0.5, 0.5};
-  scan.hits.push_back({0.5f, 0.5f, 5.0f});
-  Map map(unitConfig());
-  InsertionConfig config;
-  config.clear_conflicting_free_space = true;
-  map.insertScan(scan, config);
-  const CellVolumes cell = map.cellVolumes({0, 0});
-  ASSERT_EQ(cell.positive.size(), 1u);
-  ASSERT_EQ(cell.negative.size(), 1u);
-  EXPECT_TRUE(volumeIs(cell.negative[0], 0.5, 4.5, 4.0));
+TEST(Insertion, PreparingOutsideTheMapAndApplyingBuildTheSameMap) {
+  // ScanUpdate::prepare reads nothing of the map: a server prepares outside its lock.
+  MapConfig map_config;
+  map_config.resolution = 0.25;
+  Map direct(map_config);
+  Map two_phases(map_config);
+  ScanUpdate update;
+  for (const Scan& scan : testScans(4)) {
+    const InsertionResult expected = direct.insertScan(scan);
+    update.prepare(scan, map_config, {});
+    EXPECT_EQ(update.result().inserted(), expected.inserted());
+    const InsertionResult applied = two_phases.apply(update);
+    EXPECT_EQ(applied.obstacle_readings, expected.obstacle_readings);
+  }
+  EXPECT_TRUE(test::sameVolumes(allVolumes(two_phases), allVolumes(direct)));
+  // An update prepared for another configuration is refused, the map untouched.
+  MapConfig other = map_config;
+  other.resolution = 0.5;
+  update.prepare(testScans(5)[0], other, {});
+  const std::uint64_t revision = two_phases.revision();
+  EXPECT_THROW(two_phases.apply(update), ConfigError);
+  EXPECT_EQ(two_phases.revision(), revision);
+  other = map_config;
+  other.rules = ModelRules::paper();
+  update.prepare(testScans(5)[0], other, {});
+  EXPECT_THROW(two_phases.apply(update), ConfigError);
 }
 
-TEST(Insertion, ConflictsAreOnlyWithinOneScan) {
-  // The obstacle of an earlier scan does not stop the free space of a later one.
-  Map map(unitConfig());
-  InsertionConfig config;
-  config.clear_conflicting_free_space = true;
+TEST(Insertion, EveryRuleSetEqualsThePlainReference) {
+  // The map against test::ReferenceModel, scan after scan: the scratch tiles, the joins, the
+  // shortcuts and tiles written in place change nothing the rules decide.
+  for (const ModelRules& rules : everyRuleSet()) {
+    SCOPED_TRACE(describe(rules));
+    MapConfig map_config;
+    map_config.resolution = 0.25;
+    map_config.rules = rules;
+    Map map(map_config);
+    test::ReferenceModel reference(map_config);
+    for (const Scan& scan : testScans(17)) {
+      map.insertScan(scan);
+      reference.insertScan(scan);
+      ASSERT_TRUE(test::sameAsReference(map, reference));
+    }
+    EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+  }
+}
+
+// ---- The model's rules ---------------------------------------------------------------------------
+
+/// A scan along +x at height 0.5 in cells of 1 m: A hits cell (5, 0), B passes through it at
+/// A's height on its way to cell (8, 0), C passes above it.
+Scan scanThroughAHit() {
+  Scan scan;
+  scan.origin = {0.5, 0.5, 0.5};
+  scan.hits.push_back({5.5f, 0.5f, 0.5f});          // A: positive [0, 1] in cell (5, 0)
+  scan.hits.push_back({8.5f, 0.5f, 0.5f});          // B: crosses cell (5, 0) at z = 0.5
+  scan.out_of_range.push_back({9.5f, 0.5f, 9.5f});  // C: crosses cell (5, 0) at z in [5, 6]
+  return scan;
+}
+
+TEST(Rules, AScansFreeSpaceIsClippedAroundItsOwnHits) {
+  // Sec. V.B: B's free space in A's cell is where A hit, and goes; C's is above, and stays.
+  ModelRules rules = ModelRules::paper();
+  rules.clip_free_space_at_hits = true;
+  Map map(unitConfig(10000.0, rules));
+  map.insertScan(scanThroughAHit());
+  const CellVolumes cell = map.cellVolumes({5, 0});
+  ASSERT_EQ(cell.positive.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.positive[0], 0.0, 1.0, 1.0));
+  ASSERT_EQ(cell.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.negative[0], 5.0, 6.0, 1.0));
+  EXPECT_EQ(*map.occupancy({5.5, 0.5, 0.5}).probability, 1.0f);
+  // Cells without a hit of this scan keep all their free space; B's own hit stays.
+  EXPECT_EQ(map.cellVolumes({4, 0}).negative.size(), 2u);
+  EXPECT_EQ(map.cellVolumes({8, 0}).positive.size(), 1u);
+  // The paper's model frees A's hit with B's ray: p = 1/2 there.
+  Map paper(unitConfig());
+  paper.insertScan(scanThroughAHit());
+  EXPECT_EQ(paper.cellVolumes({5, 0}).negative.size(), 2u);
+  EXPECT_FLOAT_EQ(*paper.occupancy({5.5, 0.5, 0.5}).probability, 0.5f);
+}
+
+TEST(Rules, ClippingKeepsFreeSpaceBesideAHitAndDropsASliver) {
+  ModelRules rules = ModelRules::paper();
+  rules.clip_free_space_at_hits = true;
+  Map map(unitConfig(10000.0, rules));
+  // A steep hit straight up: V = [4.5, 5.5] and its padding [0.5, 4.5] touch without overlap,
+  // so the padding stays whole.
+  Scan up;
+  up.origin = {0.5, 0.5, 0.5};
+  up.hits.push_back({0.5f, 0.5f, 5.0f});
+  map.insertScan(up);
+  CellVolumes cell = map.cellVolumes({0, 0});
+  ASSERT_EQ(cell.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.negative[0], 0.5, 4.5, 4.0));
+  // Vertical rays in cell (3, 0): a hit at 2 (V = [1.5, 2.5], padding [0, 1.5]) and free space
+  // to 1.8 and to 3. The scan's free space [0, 3] (mass 1.5 + 1.8 + 3) loses [1.5, 2.5] to the
+  // hit; the part above it, [2.5, 3], is lower than a volume and dropped; [0, 1.5] keeps its
+  // density: mass 6.3 / 2.
+  Scan column;
+  column.origin = {3.5, 0.5, 0.0};
+  column.hits.push_back({3.5f, 0.5f, 2.0f});
+  column.out_of_range.push_back({3.5f, 0.5f, 1.8f});
+  column.out_of_range.push_back({3.5f, 0.5f, 3.0f});
+  map.insertScan(column);
+  cell = map.cellVolumes({3, 0});
+  ASSERT_EQ(cell.positive.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.positive[0], 1.5, 2.5, 1.0));
+  ASSERT_EQ(cell.negative.size(), 1u);
+  EXPECT_TRUE(volumeIs(cell.negative[0], 0.0, 1.5, 3.15));
+  EXPECT_FALSE(map.occupancy({3.5, 0.5, 2.75}).known());
+}
+
+TEST(Rules, ClippingIsWithinOneScan) {
+  // A later scan's free space clears an earlier scan's hit as in the paper (what lets a person
+  // who walked away be forgotten): the hit's column gets free space at its height.
+  Map map(unitConfig(10000.0, ModelRules{}));
   Scan first;
   first.origin = {0.5, 0.5, 0.5};
   first.hits.push_back({3.5f, 0.5f, 0.5f});
-  map.insertScan(first, config);
+  map.insertScan(first);
   Scan second = first;
   second.hits = {{6.5f, 0.5f, 0.5f}};
-  map.insertScan(second, config);
-  EXPECT_EQ(map.cellVolumes({3, 0}).negative.size(), 1u);
-  EXPECT_EQ(map.cellVolumes({3, 0}).positive.size(), 1u);
+  map.insertScan(second);
+  const PointOccupancy at_hit = map.occupancy({3.5, 0.5, 0.5});
+  ASSERT_TRUE(at_hit.known());
+  EXPECT_FLOAT_EQ(*at_hit.probability, 0.5f);  // one hit, one pass: each counted once
+}
+
+TEST(Rules, PerScanAHeightCountsOncePerScan) {
+  // 100 rays of one scan through cell (2, 0) at the same height, ending in cell (5, 0).
+  Scan scan;
+  scan.origin = {0.5, 0.5, 0.5};
+  for (int k = 0; k < 100; ++k) scan.hits.push_back({5.5f, 0.5f + 0.001f * static_cast<float>(k), 0.5f});
+  for (const MassCounting counting : {MassCounting::kPerScan, MassCounting::kPerReading}) {
+    ModelRules rules = ModelRules::paper();
+    rules.mass_counting = counting;
+    Map map(unitConfig(10000.0, rules));
+    map.insertScan(scan);
+    map.insertScan(scan);
+    const CellVolumes passed = map.cellVolumes({2, 0});
+    ASSERT_EQ(passed.negative.size(), 1u);
+    const CellVolumes hit = map.cellVolumes({5, 0});
+    ASSERT_EQ(hit.positive.size(), 1u);
+    // Per scan: density 1 per scan, 2 scans; per reading: 100 readings a scan.
+    const float expected = counting == MassCounting::kPerScan ? 2.0f : 200.0f;
+    EXPECT_FLOAT_EQ(passed.negative[0].density(), expected);
+    EXPECT_NEAR(hit.positive[0].density(), expected, expected * 0.01f);
+  }
+}
+
+TEST(Rules, PerScanTheScansFreeHeightsJoinAcrossGapsOfOne) {
+  // Cell (2, 0) holds free space [0.5, 1.5] from an earlier scan. A scan then crosses it at
+  // [-0.5, 0.5] and [1.5, 2.5]: per scan, the scan saw [-0.5, 2.5] at its vertical resolution
+  // (the gap it leaves is 1), density 1 over it: 1 + 3 = 4. Per reading (the paper), eq. (7)
+  // joins the three volumes, which touch: 1 + 1 + 1 = 3.
+  Scan earlier;
+  earlier.origin = {0.5, 0.5, 0.0};
+  earlier.out_of_range.push_back({3.5f, 0.5f, 1.5f});  // z 0.75 to 1.25 in cell 2: [0.5, 1.5]
+  Scan later = earlier;
+  later.out_of_range = {{3.5f, 0.5f, 0.0f}, {3.5f, 0.5f, 3.0f}};  // [-0.5, 0.5], [1.5, 2.5]
+  for (const MassCounting counting : {MassCounting::kPerScan, MassCounting::kPerReading}) {
+    ModelRules rules = ModelRules::paper();
+    rules.mass_counting = counting;
+    Map map(unitConfig(10000.0, rules));
+    map.insertScan(earlier);
+    map.insertScan(later);
+    const CellVolumes cell = map.cellVolumes({2, 0});
+    ASSERT_EQ(cell.negative.size(), 1u);
+    EXPECT_TRUE(volumeIs(cell.negative[0], -0.5, 2.5,
+                         counting == MassCounting::kPerScan ? 4.0 : 3.0));
+  }
+}
+
+TEST(Rules, ARingOfLaserHitsStaysOccupied) {
+  // 5 identical scans of 360 beams, every range 4 m, from a laser at (0, 0, 1), cells of 0.1 m:
+  // the beams to neighbouring ring cells cross ring cells on their way. With the defaults every
+  // ring point is occupied (the scan does not free its own hits); the paper's model loses some.
+  Scan scan;
+  scan.origin = {0.0, 0.0, 1.0};
+  for (int beam = 0; beam < 360; ++beam) {
+    const double angle = beam * M_PI / 180.0;
+    scan.hits.push_back(Eigen::Vector3f(static_cast<float>(4.0 * std::cos(angle)),
+                                        static_cast<float>(4.0 * std::sin(angle)), 1.0f));
+  }
+  auto occupied_on_ring = [&](const ModelRules& rules, double threshold) {
+    MapConfig config;
+    config.resolution = 0.1;
+    config.rules = rules;
+    Map map(config);
+    for (int k = 0; k < 5; ++k) map.insertScan(scan);
+    int occupied = 0;
+    for (int k = 0; k < 60; ++k) {
+      const double angle = (k + 0.5) * 2.0 * M_PI / 60.0;
+      const Eigen::Vector3d point(4.0 * std::cos(angle), 4.0 * std::sin(angle), 1.0);
+      occupied += map.occupancy(point).state(threshold) == OccupancyState::kOccupied;
+      // The 2 m circle is free.
+      EXPECT_EQ(map.occupancy(point / 2.0 + Eigen::Vector3d(0, 0, 0.5)).state(threshold),
+                OccupancyState::kFree);
+    }
+    return occupied;
+  };
+  const int occupied = occupied_on_ring(ModelRules{}, kDefaultOccupancyThreshold);
+  EXPECT_GE(occupied, 50);
+  EXPECT_GE(occupied, occupied_on_ring(ModelRules::paper(), kPaperOccupancyThreshold));
 }
 
 }  // namespace

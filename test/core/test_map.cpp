@@ -120,18 +120,21 @@ TEST(Decay, NewReadingsWeighMoreThanOldOnes) {
 
 TEST(Decay, LongDecayedReadingsGiveWayToNewOnes) {
   // After 500 halvings the old obstacle weighs 2^-500 of a new reading: one free reading makes
-  // the point free, and the map stays valid.
+  // the point free, and the map stays valid. A tile no reading writes keeps its probabilities;
+  // masses in the tile written, decayed below float range against the new ones, become 0.
   Map map(unitConfig());
   map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, ReadingKind::kObstacle);
-  map.insertReading({3.5, 0.5, 0}, {3.5, 0.5, 5}, ReadingKind::kObstacle);  // untouched below
-  const PointOccupancy untouched = map.occupancy({3.5, 0.5, 5.0});
+  map.insertReading({3.5, 0.5, 0}, {3.5, 0.5, 5}, ReadingKind::kObstacle);  // same tile
+  map.insertReading({40.5, 0.5, 0}, {40.5, 0.5, 5}, ReadingKind::kObstacle);  // untouched below
+  const PointOccupancy untouched = map.occupancy({40.5, 0.5, 5.0});
   for (int step = 0; step < 500; ++step) map.decay(0.5);
   map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 6}, ReadingKind::kOutOfRange);
   const PointOccupancy p = map.occupancy({0.5, 0.5, 5.0});
   ASSERT_TRUE(p.known());
   EXPECT_LT(*p.probability, 1e-6f);
   EXPECT_NEAR(p.negative_density, 1.0, 1e-6);
-  EXPECT_EQ(map.occupancy({3.5, 0.5, 5.0}).probability, untouched.probability);
+  EXPECT_EQ(map.occupancy({40.5, 0.5, 5.0}).probability, untouched.probability);
+  EXPECT_FALSE(map.occupancy({3.5, 0.5, 5.0}).known());
   EXPECT_TRUE(test::mapSatisfiesConstraints(map));
   // Fresh readings get the masses of fresh readings.
   map.insertReading({-5.5, 0.5, 0}, {-5.5, 0.5, 5}, ReadingKind::kObstacle);
@@ -369,7 +372,7 @@ TEST(MemoryUsage, EmptyMap) {
 }
 
 TEST(MemoryUsage, CountsMatchTheVolumesAndTableOneAccounting) {
-  Map map(MapConfig{0.2, 1000.0});
+  Map map(MapConfig{0.2, 1000.0, ModelRules{}});
   std::mt19937 rng(8);
   std::size_t previous_bytes = map.memoryUsage().bytes_held;
   for (int k = 0; k < 4; ++k) {
@@ -421,16 +424,16 @@ TEST(Config, DefaultsAreValid) {
 
 TEST(Config, MapConfigFieldsAreChecked) {
   const std::vector<std::pair<MapConfig, std::string>> bad{
-      {{0.0, 100.0}, "resolution"},        {{-0.1, 100.0}, "resolution"},
-      {{kNaN, 100.0}, "resolution"},       {{kInf, 100.0}, "resolution"},
-      {{0.1, 0.0}, "max_coordinate"},      {{0.1, -5.0}, "max_coordinate"},
-      {{0.1, kNaN}, "max_coordinate"},     {{0.1, kInf}, "max_coordinate"},
-      {{0.001, 10000.0}, "max_coordinate"}};  // 10^7 cells: heights would not resolve a cell
+      {{0.0, 100.0, {}}, "resolution"},        {{-0.1, 100.0, {}}, "resolution"},
+      {{kNaN, 100.0, {}}, "resolution"},       {{kInf, 100.0, {}}, "resolution"},
+      {{0.1, 0.0, {}}, "max_coordinate"},      {{0.1, -5.0, {}}, "max_coordinate"},
+      {{0.1, kNaN, {}}, "max_coordinate"},     {{0.1, kInf, {}}, "max_coordinate"},
+      {{0.001, 10000.0, {}}, "max_coordinate"}};  // 10^7 cells: heights would not resolve a cell
   for (const auto& [config, field] : bad) {
     expectConfigError([&] { config.validate(); }, field);
     expectConfigError([&] { Map map(config); }, field);
   }
-  EXPECT_NO_THROW({ Map map(MapConfig{0.001, 4194.0}); });
+  EXPECT_NO_THROW({ Map map(MapConfig{0.001, 4194.0, ModelRules{}}); });
 }
 
 TEST(Config, InsertionConfigFieldsAreChecked) {

@@ -118,7 +118,7 @@ std::vector<CellRecord> smallCells() {
 }
 
 Map smallMap() {
-  Map map(MapConfig{0.5, 100.0});
+  Map map(MapConfig{0.5, 100.0, ModelRules{}});
   for (const CellRecord& c : smallCells()) {
     map.setCellVolumes({c.x, c.y}, CellVolumes{c.positive, c.negative});
   }
@@ -143,7 +143,7 @@ Map smallMap() {
 TEST(MapIo, LayoutIsTheDocumentedOne) {
   // Cells in the order the map stores them: rows of tiles from the lowest, tile (-1, 0) first.
   EXPECT_EQ(serializeMap(smallMap()), buildFile(0.5, 100.0, smallCells()));
-  const Bytes empty = serializeMap(Map(MapConfig{0.25, 50.0}));
+  const Bytes empty = serializeMap(Map(MapConfig{0.25, 50.0, ModelRules{}}));
   EXPECT_EQ(empty, buildFile(0.25, 50.0, {}));
   EXPECT_EQ(empty.size(), kMapHeaderBytes + 8);
 }

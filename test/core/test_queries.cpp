@@ -27,7 +27,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 ///   positive: [0, 2] mass 6 (rho+ = 3), [6, 8] mass 2 (rho+ = 1)
 ///   negative: [1, 5] mass 4 (rho- = 1), [7.5, 9] mass 0 (rho- = 0)
 Map handMadeMap() {
-  Map map(MapConfig{0.5, 1000.0});
+  Map map(MapConfig{0.5, 1000.0, ModelRules::paper()});
   CellVolumes volumes;
   volumes.positive = {{0.0f, 2.0f, 6.0f}, {6.0f, 8.0f, 2.0f}};
   volumes.negative = {{1.0f, 5.0f, 4.0f}, {7.5f, 9.0f, 0.0f}};

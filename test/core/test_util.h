@@ -19,11 +19,14 @@
 namespace mvog {
 namespace test {
 
-/// A map at resolution 1 (s = 1): grid units are metres, as in the paper's Fig. 3.
-inline MapConfig unitConfig(double max_coordinate = 10000.0) {
+/// A map at resolution 1 (s = 1): grid units are metres, as in the paper's Fig. 3; by default
+/// with the paper's exact model.
+inline MapConfig unitConfig(double max_coordinate = 10000.0,
+                            const ModelRules& rules = ModelRules::paper()) {
   MapConfig config;
   config.resolution = 1.0;
   config.max_coordinate = max_coordinate;
+  config.rules = rules;
   return config;
 }
 
@@ -91,9 +94,12 @@ inline std::vector<CellIndex> observedCells(const Map& map) {
   return cells;
 }
 
-/// Sec. III-A written out again, without mvog::checkVolumeList: sorted, heights >= 1, no overlap,
-/// gaps > 1 (in float, as the map computes them), finite non-negative masses.
-inline ::testing::AssertionResult satisfiesConstraints(const std::vector<Volume>& list) {
+/// Sec. III-A written out again, without mvog::checkColumn: sorted, heights >= 1, no overlap,
+/// gaps > 1 (in float, as the map computes them), finite non-negative masses. Two volumes may
+/// touch where one of `boundaries` begins or ends (ModelRules::split_free_space_at_obstacles:
+/// negative volumes cut at the positive ones).
+inline ::testing::AssertionResult satisfiesConstraints(const std::vector<Volume>& list,
+                                                      const std::vector<Volume>& boundaries = {}) {
   for (std::size_t k = 0; k < list.size(); ++k) {
     const Volume& v = list[k];
     std::ostringstream where;
@@ -106,6 +112,12 @@ inline ::testing::AssertionResult satisfiesConstraints(const std::vector<Volume>
     }
     if (k > 0) {
       const Volume& below = list[k - 1];
+      const bool at_a_boundary =
+          below.top == v.bottom &&
+          std::any_of(boundaries.begin(), boundaries.end(), [&](const Volume& b) {
+            return b.bottom == v.bottom || b.top == v.bottom;
+          });
+      if (at_a_boundary) continue;
       if (!(below.bottom < v.bottom) || !(below.top < v.bottom)) {
         return ::testing::AssertionFailure() << where.str() << "unsorted or overlapping";
       }
@@ -117,22 +129,27 @@ inline ::testing::AssertionResult satisfiesConstraints(const std::vector<Volume>
   return ::testing::AssertionSuccess();
 }
 
-/// Both the independent check and mvog::checkVolumeList hold for every list of `map`.
+/// Both the independent check and mvog::checkColumn hold for every column of `map`.
 inline ::testing::AssertionResult mapSatisfiesConstraints(const Map& map) {
+  const bool split = map.config().rules.split_free_space_at_obstacles;
   for (const CellIndex& cell : observedCells(map)) {
     const CellVolumes volumes = map.cellVolumes(cell);
     for (const std::vector<Volume>* list : {&volumes.positive, &volumes.negative}) {
       const char* name = list == &volumes.positive ? "positive" : "negative";
-      const ::testing::AssertionResult own = satisfiesConstraints(*list);
+      const bool may_touch = split && list == &volumes.negative;
+      const ::testing::AssertionResult own =
+          satisfiesConstraints(*list, may_touch ? volumes.positive : std::vector<Volume>{});
       if (!own) {
         return ::testing::AssertionFailure()
                << "cell (" << cell.x << ", " << cell.y << ") " << name << ": " << own.message();
       }
-      const std::string problem = checkVolumeList(list->data(), list->size());
-      if (!problem.empty()) {
-        return ::testing::AssertionFailure() << "cell (" << cell.x << ", " << cell.y << ") " << name
-                                             << ": checkVolumeList: " << problem;
-      }
+    }
+    const std::string problem =
+        checkColumn(volumes.positive.data(), volumes.positive.size(), volumes.negative.data(),
+                    volumes.negative.size(), split);
+    if (!problem.empty()) {
+      return ::testing::AssertionFailure()
+             << "cell (" << cell.x << ", " << cell.y << "): checkColumn: " << problem;
     }
   }
   return ::testing::AssertionSuccess();
@@ -208,10 +225,12 @@ inline Scan randomScan(std::mt19937& rng, const Eigen::Vector3d& origin, std::si
 
 /// A map built from `num_scans` random scans from near the origin, each of 1200 hits and 400
 /// out-of-range readings within half_extent (m).
-inline Map randomMap(unsigned seed, double resolution, double half_extent, int num_scans = 3) {
+inline Map randomMap(unsigned seed, double resolution, double half_extent, int num_scans = 3,
+                     const ModelRules& rules = {}) {
   MapConfig config;
   config.resolution = resolution;
   config.max_coordinate = 1000.0;
+  config.rules = rules;
   Map map(config);
   std::mt19937 rng(seed);
   for (int k = 0; k < num_scans; ++k) {

@@ -164,16 +164,8 @@ std::unordered_set<std::uint64_t> voxelsCrossed(const InputData& input, double m
 
 WalkStats runWalk(const InputData& input, const RunOptions& options) {
   const double s = 1.0 / options.resolution;
-  mvog::CellRange cells{{0, 0}, {-1, -1}};
-  auto include = [&](const Eigen::Vector3d& p) {
-    const mvog::CellIndex c = mvog::cellAt(p.x() * s, p.y() * s);
-    if (cells.empty()) {
-      cells = {c, c};
-      return;
-    }
-    cells.min = {std::min(cells.min.x, c.x), std::min(cells.min.y, c.y)};
-    cells.max = {std::max(cells.max.x, c.x), std::max(cells.max.y, c.y)};
-  };
+  mvog::CellRange cells = mvog::kNoCells;
+  auto include = [&](const Eigen::Vector3d& p) { cells.extend(mvog::cellAt(p.x() * s, p.y() * s)); };
   std::vector<std::vector<Eigen::Vector3d>> ends(input.scans.size());
   for (std::size_t k = 0; k < input.scans.size(); ++k) {
     include(input.scans[k].origin);

@@ -1,0 +1,186 @@
+// What a scan's rasterisation collects per column before the constraints are applied (internal
+// to the core): ScanUpdate fills it, Map::apply reads it.
+#pragma once
+
+#include <cstddef>
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "mvog/scan_update.h"
+#include "thread_pool.h"
+#include "tile_block.h"
+
+namespace mvog {
+namespace detail {
+
+/// New volumes of one list of one column joined where they overlap or touch (eq. 7), or, with
+/// MassCounting::kPerScan, where they are at most kMaxMergeGap apart (one scan sees a column at
+/// the model's vertical resolution: a gap it leaves of 1 or less is not resolved, and eq. 8
+/// would close it anyway). Each carries the summed mass of what it joined: density-1 masses
+/// (heights) summed in double. Every height is a float of at least 1, a multiple of 2^-23, so the
+/// sums are exact (whatever their order) while a column's total stays below 2^30 cells of height
+/// in one scan.
+struct ScanInterval {
+  float bottom;
+  float top;
+  double mass;
+};
+
+/// A column's free space so far in one scan: the interval its last ray reached inline, with the
+/// nearest of its other intervals below and above (kept aside, if any), so that the next ray,
+/// which mostly reaches the same interval, grows it inline.
+struct FreeSlot {
+  float bottom;
+  float top;
+  float below;  ///< top of the next interval below, or -infinity
+  float above;  ///< bottom of the next interval above, or +infinity
+  /// The stamp of the scan the slot holds (so that no slot needs clearing between scans).
+  std::uint32_t stamp;
+  std::uint32_t others;  ///< index of the other intervals kept aside, or kNoOthers
+};
+constexpr std::uint32_t kNoOthers = 0xffffffffu;
+
+/// A hit's positive volume (eq. 5) in a cell of a tile.
+struct TileHit {
+  std::uint16_t local;
+  float bottom;
+  float top;
+};
+
+struct ScratchTile {
+  FreeSlot slots[kCellsPerTile];
+  /// With MassCounting::kPerReading: the mass of each slot's inline interval.
+  double masses[kCellsPerTile];
+  std::vector<TileHit> hits;
+};
+
+/// Whether two intervals, one not below the other, join: the upper one's bottom is at most
+/// `join_gap` above the lower one's top.
+inline bool joins(float lower_top, float upper_bottom, float join_gap) {
+  return upper_bottom - lower_top <= join_gap;
+}
+
+/// One thread's part of a scan: the tiles its readings reached.
+class ScanScratch {
+ public:
+  /// Forgets the previous scan (its memory is kept for the next). Intervals less than
+  /// `join_gap` apart will join (0: only overlapping or touching ones); masses are summed only
+  /// if `count_masses`. The readings will stay within the tiles of `tiles` if it is not empty.
+  void begin(float join_gap, bool count_masses, const CellRange& tiles);
+
+  /// Adds one scan's volumes to the scratch; kept by one ray walk, so that what every cell
+  /// visit needs stays in registers.
+  template <bool kCountMasses>
+  class Writer {
+   public:
+    explicit Writer(ScanScratch& scratch)
+        : scratch_(scratch), stamp_(scratch.stamp_), join_gap_(scratch.join_gap_) {}
+    /// Called for every cell a ray crosses: the commonest case (the interval inline grows and
+    /// reaches no other) stays inline in the ray walk.
+    void addFree(const CellIndex& cell, const Volume& volume) {
+      ScratchTile& tile = tileFor(cell);
+      const unsigned local = localIndex(cell);
+      FreeSlot& slot = tile.slots[local];
+      if (slot.stamp == stamp_ &&
+          std::max(volume.bottom - slot.top, slot.bottom - volume.top) <= join_gap_ &&
+          std::min(volume.bottom - slot.below, slot.above - volume.top) > join_gap_) {
+        slot.bottom = std::min(slot.bottom, volume.bottom);
+        slot.top = std::max(slot.top, volume.top);
+        if (kCountMasses) tile.masses[local] += volume.mass;
+        return;
+      }
+      scratch_.addFreeSlow(tile, local, volume);
+    }
+    void addHit(const CellIndex& cell, const Volume& volume) {
+      tileFor(cell).hits.push_back(
+          {static_cast<std::uint16_t>(localIndex(cell)), volume.bottom, volume.top});
+    }
+
+   private:
+    ScratchTile& tileFor(const CellIndex& cell) {
+      const std::int32_t tx = cell.x >> kTileSizeLog2;
+      const std::int32_t ty = cell.y >> kTileSizeLog2;
+      // Consecutive cells of a ray mostly share a tile.
+      if (tile_ == nullptr || tx != x_ || ty != y_) {
+        tile_ = &scratch_.findOrAddTile(tx, ty);
+        x_ = tx;
+        y_ = ty;
+      }
+      return *tile_;
+    }
+
+    ScanScratch& scratch_;
+    const std::uint32_t stamp_;
+    const float join_gap_;
+    ScratchTile* tile_ = nullptr;
+    std::int32_t x_ = 0;
+    std::int32_t y_ = 0;
+  };
+
+  /// The tile `key` of this scan, or nullptr.
+  const ScratchTile* find(std::uint64_t key) const;
+  /// Every tile this scan reached, by key.
+  const std::vector<std::pair<std::uint64_t, ScratchTile*>>& tiles() const { return reached_; }
+  /// Whether this scan's rays reached cell `local` of `tile`.
+  bool reached(const ScratchTile& tile, unsigned local) const {
+    return tile.slots[local].stamp == stamp_;
+  }
+  /// Whether cell `local` of `tile` holds exactly one free interval; if so, sets it.
+  bool singleFree(const ScratchTile& tile, unsigned local, ScanInterval& interval) const {
+    const FreeSlot& slot = tile.slots[local];
+    if (slot.stamp != stamp_ || slot.others != kNoOthers) return false;
+    interval = {slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
+    return true;
+  }
+  /// Appends the free intervals of cell `local` of `tile` (sorted, disjoint) to `out`; their
+  /// masses are 0 unless counted.
+  void appendFree(const ScratchTile& tile, unsigned local, std::vector<ScanInterval>& out) const;
+
+ private:
+  ScratchTile& findOrAddTile(std::int32_t tile_x, std::int32_t tile_y);
+  /// A slot's first interval of the scan, or one that does not only grow its inline interval.
+  void addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume);
+
+  /// The tiles reached, by key, and the index from tile to scratch: dense over the scan's tiles
+  /// when they are few enough, else hashed.
+  std::vector<std::pair<std::uint64_t, ScratchTile*>> reached_;
+  CellRange dense_tiles_ = kNoCells;
+  std::vector<ScratchTile*> dense_;
+  std::unordered_map<std::uint64_t, ScratchTile*> hashed_;
+  std::vector<std::unique_ptr<ScratchTile>> pool_;
+  /// The intervals of columns with several, but for the one inline (sorted).
+  std::vector<std::vector<ScanInterval>> others_;
+  std::size_t others_used_ = 0;
+  std::uint32_t stamp_ = 0;
+  float join_gap_ = 0.0f;
+  bool count_masses_ = false;
+};
+
+/// Joins [bottom, top] into the sorted `list` of intervals more than `join_gap` apart; returns
+/// the index of the interval that holds it.
+std::size_t joinInterval(std::vector<ScanInterval>& list, float bottom, float top, double mass,
+                         float join_gap);
+/// Joins the intervals of a list sorted by bottom that come within `join_gap`, in place.
+void joinSorted(std::vector<ScanInterval>& intervals, float join_gap);
+/// The gap under which one scan's intervals join (see ScanInterval).
+inline float joinGapOf(const ModelRules& rules) {
+  return rules.mass_counting == MassCounting::kPerScan ? kMaxMergeGap : 0.0f;
+}
+
+}  // namespace detail
+
+struct ScanUpdate::Impl {
+  MapConfig map_config;
+  InsertionResult result;
+  /// One per chunk of readings (one per thread).
+  std::vector<detail::ScanScratch> scratches;
+  std::unique_ptr<detail::ThreadPool> pool;
+
+  /// Threads for `insertion_threads`, started once.
+  detail::ThreadPool* threads(std::size_t count);
+};
+
+}  // namespace mvog

@@ -1,0 +1,316 @@
+// The first half of the scan update of Fig. 2: rasterisation (Sec. III-B.1) and the creation of
+// new volumes (Sec. III-B.2), collected per column.
+#include "mvog/scan_update.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "mvog/raster.h"
+#include "scan_scratch.h"
+
+namespace mvog {
+namespace detail {
+
+std::size_t joinInterval(std::vector<ScanInterval>& list, float bottom, float top, double mass,
+                         float join_gap) {
+  // Columns hold a few intervals: a linear scan to the first that is not wholly below.
+  auto first = list.begin();
+  while (first != list.end() && !joins(first->top, bottom, join_gap)) ++first;
+  const auto index = static_cast<std::size_t>(first - list.begin());
+  if (first == list.end() || !joins(top, first->bottom, join_gap)) {
+    list.insert(first, {bottom, top, mass});
+    return index;
+  }
+  ScanInterval joined{std::min(bottom, first->bottom), top, mass};
+  auto last = first;
+  for (; last != list.end() && joins(joined.top, last->bottom, join_gap); ++last) {
+    joined.top = std::max(joined.top, last->top);
+    joined.mass += last->mass;
+  }
+  *first = joined;
+  list.erase(first + 1, last);
+  return index;
+}
+
+void joinSorted(std::vector<ScanInterval>& intervals, float join_gap) {
+  std::size_t out = 0;
+  for (std::size_t k = 0; k < intervals.size(); ++k) {
+    if (out > 0 && joins(intervals[out - 1].top, intervals[k].bottom, join_gap)) {
+      intervals[out - 1].top = std::max(intervals[out - 1].top, intervals[k].top);
+      intervals[out - 1].mass += intervals[k].mass;
+    } else {
+      intervals[out++] = intervals[k];
+    }
+  }
+  intervals.resize(out);
+}
+
+/// The most tiles a scan's dense tile index spans (512 KB of pointers); a scan reaching wider
+/// (a far reading) indexes its tiles in a hash map.
+constexpr std::int64_t kMaxDenseTiles = std::int64_t{1} << 16;
+
+void ScanScratch::begin(float join_gap, bool count_masses, const CellRange& tiles) {
+  join_gap_ = join_gap;
+  count_masses_ = count_masses;
+  reached_.clear();
+  hashed_.clear();
+  others_used_ = 0;
+  if (!tiles.empty() && tiles.width() * tiles.height() <= kMaxDenseTiles) {
+    dense_tiles_ = tiles;
+    dense_.assign(static_cast<std::size_t>(tiles.width() * tiles.height()), nullptr);
+  } else {
+    dense_tiles_ = kNoCells;
+  }
+  if (++stamp_ == 0) {  // after 2^32 scans: no slot may keep the new stamp from long ago
+    for (auto& tile : pool_) {
+      for (FreeSlot& slot : tile->slots) slot.stamp = 0;
+    }
+    stamp_ = 1;
+  }
+}
+
+ScratchTile& ScanScratch::findOrAddTile(std::int32_t tile_x, std::int32_t tile_y) {
+  ScratchTile** slot = nullptr;
+  if (dense_tiles_.contains({tile_x, tile_y})) {
+    slot = &dense_[static_cast<std::size_t>(tile_y - dense_tiles_.min.y) *
+                       static_cast<std::size_t>(dense_tiles_.width()) +
+                   static_cast<std::size_t>(tile_x - dense_tiles_.min.x)];
+  } else {
+    slot = &hashed_[tileKey(tile_x, tile_y)];
+  }
+  if (*slot == nullptr) {
+    if (reached_.size() == pool_.size()) {
+      pool_.push_back(std::make_unique<ScratchTile>());
+      for (FreeSlot& s : pool_.back()->slots) s.stamp = 0;
+    }
+    *slot = pool_[reached_.size()].get();
+    (*slot)->hits.clear();
+    reached_.emplace_back(tileKey(tile_x, tile_y), *slot);
+  }
+  return **slot;
+}
+
+void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume) {
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  FreeSlot& slot = tile.slots[local];
+  const double mass = count_masses_ ? static_cast<double>(volume.mass) : 0.0;
+  if (slot.stamp != stamp_) {  // the cell's first interval of this scan
+    slot = {volume.bottom, volume.top, -kInfinity, kInfinity, stamp_, kNoOthers};
+    tile.masses[local] = mass;
+    return;
+  }
+  if (slot.others == kNoOthers) {
+    if (others_used_ == others_.size()) others_.emplace_back();
+    slot.others = static_cast<std::uint32_t>(others_used_++);
+    others_[slot.others].clear();
+  }
+  // Join the volume into all of the cell's intervals, then keep the one it reached inline.
+  std::vector<ScanInterval>& list = others_[slot.others];
+  const ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
+  list.insert(std::partition_point(list.begin(), list.end(),
+                                   [&](const ScanInterval& i) { return i.top < current.bottom; }),
+              current);
+  const std::size_t k = joinInterval(list, volume.bottom, volume.top, mass, join_gap_);
+  slot.bottom = list[k].bottom;
+  slot.top = list[k].top;
+  tile.masses[local] = list[k].mass;
+  list.erase(list.begin() + static_cast<std::ptrdiff_t>(k));
+  slot.below = k > 0 ? list[k - 1].top : -kInfinity;
+  slot.above = k < list.size() ? list[k].bottom : kInfinity;
+}
+
+const ScratchTile* ScanScratch::find(std::uint64_t key) const {
+  const std::int32_t x = tileKeyX(key);
+  const std::int32_t y = tileKeyY(key);
+  if (dense_tiles_.contains({x, y})) {
+    return dense_[static_cast<std::size_t>(y - dense_tiles_.min.y) *
+                      static_cast<std::size_t>(dense_tiles_.width()) +
+                  static_cast<std::size_t>(x - dense_tiles_.min.x)];
+  }
+  const auto it = hashed_.find(key);
+  return it == hashed_.end() ? nullptr : it->second;
+}
+
+void ScanScratch::appendFree(const ScratchTile& tile, unsigned local,
+                             std::vector<ScanInterval>& out) const {
+  const FreeSlot& slot = tile.slots[local];
+  if (slot.stamp != stamp_) return;
+  const ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
+  if (slot.others == kNoOthers) {
+    out.push_back(current);
+    return;
+  }
+  const std::vector<ScanInterval>& list = others_[slot.others];
+  bool placed = false;
+  for (const ScanInterval& i : list) {
+    if (!placed && current.bottom < i.bottom) {
+      out.push_back(current);
+      placed = true;
+    }
+    out.push_back(i);
+  }
+  if (!placed) out.push_back(current);
+}
+
+namespace {
+
+/// Checks one reading and counts it in `result`; on acceptance sets the ray's end (truncated to
+/// max_range) and whether it ends in an obstacle.
+bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, ReadingKind kind,
+                   double max_coordinate, const InsertionConfig& config, Eigen::Vector3d& ray_end,
+                   bool& obstacle, InsertionResult& result) {
+  const bool is_obstacle = kind == ReadingKind::kObstacle;
+  if (!origin.allFinite() || !end.allFinite()) {
+    ++result.rejected_non_finite;
+    return false;
+  }
+  if (origin.cwiseAbs().maxCoeff() > max_coordinate || end.cwiseAbs().maxCoeff() > max_coordinate) {
+    ++result.rejected_out_of_bounds;
+    return false;
+  }
+  const Eigen::Vector3d ray = end - origin;
+  const double length = ray.norm();
+  // A zero-length out-of-range reading carries no free space; a zero-length hit is below any
+  // min_range but the sensor itself (decision: both are dropped as too close).
+  if (length == 0.0 || (is_obstacle && length < config.min_range)) {
+    ++result.rejected_too_close;
+    return false;
+  }
+  obstacle = is_obstacle && length <= config.max_range;
+  if (!obstacle && !config.insert_out_of_range) {
+    ++result.ignored_out_of_range;
+    return false;
+  }
+  ray_end =
+      length > config.max_range ? Eigen::Vector3d(origin + ray * (config.max_range / length)) : end;
+  if (obstacle) {
+    ++result.obstacle_readings;
+  } else {
+    ++result.out_of_range_readings;
+    if (is_obstacle) ++result.truncated_to_max_range;
+  }
+  return true;
+}
+
+/// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`.
+template <class Writer>
+void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
+                bool model_negative_space, Writer& scratch) {
+  const auto end_z = static_cast<float>(end.z());
+  if (!model_negative_space) {
+    // Only the obstacle's own volume, in the cell the walk would end in (see walkRay): no walk.
+    if (obstacle) scratch.addHit(cellAt(end.x(), end.y()), makeVolume(end_z - 0.5f, end_z + 0.5f));
+    return;
+  }
+  walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
+          [&](const CellIndex& cell, double z_enter, double z_exit, bool is_last) {
+            if (!is_last || !obstacle) {  // eqs. (3) and (4)
+              scratch.addFree(cell, makeVolume(static_cast<float>(z_enter),
+                                               static_cast<float>(z_exit)));
+              return;
+            }
+            const Volume positive = makeVolume(end_z - 0.5f, end_z + 0.5f);  // eq. (5)
+            scratch.addHit(cell, positive);
+            if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
+              scratch.addFree(cell, makeVolume(static_cast<float>(z_enter),
+                                               z_enter < end.z() ? positive.bottom : positive.top));
+            }
+          });
+}
+
+/// Readings [first, last) of `scan` (its hits, then its out-of-range readings), checked,
+/// counted and rasterised into `writer`.
+template <class Writer>
+void rasterizeReadings(const Scan& scan, std::size_t first, std::size_t last,
+                       const MapConfig& map_config, const InsertionConfig& insertion,
+                       Writer& writer, InsertionResult& result) {
+  const double s = 1.0 / map_config.resolution;
+  const Eigen::Vector3d start = scan.origin * s;
+  const std::size_t num_hits = scan.hits.size();
+  auto add = [&](const Eigen::Vector3f& end, ReadingKind kind) {
+    Eigen::Vector3d ray_end;
+    bool obstacle = false;
+    if (acceptReading(scan.origin, end.cast<double>(), kind, map_config.max_coordinate, insertion,
+                      ray_end, obstacle, result)) {
+      addReading(start, ray_end * s, obstacle, insertion.model_negative_space, writer);
+    }
+  };
+  const auto began = std::chrono::steady_clock::now();
+  for (std::size_t k = first; k < std::min(last, num_hits); ++k) {
+    add(scan.hits[k], ReadingKind::kObstacle);
+  }
+  const auto hits_done = std::chrono::steady_clock::now();
+  for (std::size_t k = std::max(first, num_hits); k < last; ++k) {
+    add(scan.out_of_range[k - num_hits], ReadingKind::kOutOfRange);
+  }
+  result.obstacle_seconds = std::chrono::duration<double>(hits_done - began).count();
+  result.out_of_range_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - hits_done).count();
+}
+
+}  // namespace
+}  // namespace detail
+
+detail::ThreadPool* ScanUpdate::Impl::threads(std::size_t count) {
+  if (count <= 1) return nullptr;
+  if (pool == nullptr || pool->threads() != count) pool = std::make_unique<detail::ThreadPool>(count);
+  return pool.get();
+}
+
+ScanUpdate::ScanUpdate() : impl_(std::make_unique<Impl>()) {}
+ScanUpdate::~ScanUpdate() = default;
+ScanUpdate::ScanUpdate(ScanUpdate&&) noexcept = default;
+ScanUpdate& ScanUpdate::operator=(ScanUpdate&&) noexcept = default;
+
+const InsertionResult& ScanUpdate::result() const { return impl_->result; }
+
+void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
+                         const InsertionConfig& insertion) {
+  map_config.validate();
+  insertion.validate();
+  Impl& impl = *impl_;
+  impl.map_config = map_config;
+  impl.result = InsertionResult{};
+  const auto num_threads = static_cast<std::size_t>(insertion.insertion_threads);
+  impl.scratches.resize(num_threads);
+  const std::size_t num_hits = scan.hits.size();
+  const std::size_t num_readings = num_hits + scan.out_of_range.size();
+  const double s = 1.0 / map_config.resolution;
+  std::vector<InsertionResult> results(num_threads);
+  // Chunk k of the readings (hits, then out-of-range readings) goes to scratch k.
+  auto rasterize = [&](std::size_t, std::size_t chunk) {
+    detail::ScanScratch& scratch = impl.scratches[chunk];
+    const std::size_t first = num_readings * chunk / num_threads;
+    const std::size_t last = num_readings * (chunk + 1) / num_threads;
+    // The tiles of the chunk's rays (those it may accept) for the scratch's dense index.
+    CellRange tiles = kNoCells;
+    auto reach = [&](const Eigen::Vector3d& p) {
+      if (!p.allFinite() || p.cwiseAbs().maxCoeff() > map_config.max_coordinate) return;
+      const CellIndex cell = cellAt(p.x() * s, p.y() * s);
+      tiles.extend(CellIndex{cell.x >> detail::kTileSizeLog2, cell.y >> detail::kTileSizeLog2});
+    };
+    reach(scan.origin);
+    for (std::size_t k = first; k < last; ++k) {
+      reach((k < num_hits ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>());
+    }
+    const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
+    scratch.begin(detail::joinGapOf(map_config.rules), count_masses, tiles);
+    if (count_masses) {
+      detail::ScanScratch::Writer<true> writer(scratch);
+      detail::rasterizeReadings(scan, first, last, map_config, insertion, writer, results[chunk]);
+    } else {
+      detail::ScanScratch::Writer<false> writer(scratch);
+      detail::rasterizeReadings(scan, first, last, map_config, insertion, writer, results[chunk]);
+    }
+  };
+  if (detail::ThreadPool* pool = impl.threads(num_threads)) {
+    pool->run(num_threads, rasterize);
+  } else {
+    rasterize(0, 0);
+  }
+  for (const InsertionResult& r : results) impl.result += r;
+}
+
+}  // namespace mvog

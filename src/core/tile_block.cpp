@@ -1,0 +1,201 @@
+#include "tile_block.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+
+namespace mvog {
+namespace detail {
+
+TileBlock::~TileBlock() { std::free(block_); }
+
+TileBlock& TileBlock::operator=(TileBlock&& other) noexcept {
+  if (this != &other) {
+    std::free(block_);
+    block_ = other.block_;
+    other.block_ = nullptr;
+  }
+  return *this;
+}
+
+std::size_t TileBlock::volumesOffset(std::uint32_t num_cells, bool wide) {
+  const std::size_t counts =
+      wide ? 4 * (2 * std::size_t{num_cells} + 1) : 2 * (std::size_t{num_cells} + 1) + num_cells;
+  const std::size_t end = sizeof(Header) + counts;
+  return (end + alignof(Volume) - 1) / alignof(Volume) * alignof(Volume);
+}
+
+std::size_t TileBlock::bytes() const {
+  if (block_ == nullptr) return 0;
+  return volumesOffset(block_->num_cells, block_->wide != 0) +
+         std::size_t{block_->num_volumes} * sizeof(Volume);
+}
+
+namespace {
+
+/// Bits set in x, without a library call (the build targets no particular x86 level, where
+/// __builtin_popcountll calls libgcc).
+unsigned bitCount(std::uint64_t x) {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<unsigned>((x * 0x0101010101010101ull) >> 56);
+}
+
+}  // namespace
+
+unsigned TileBlock::rank(unsigned local) const {
+  const unsigned word = local >> 6;
+  unsigned count = 0;
+  for (unsigned w = 0; w < word; ++w) count += bitCount(block_->occupied[w]);
+  const std::uint64_t below = (std::uint64_t{1} << (local & 63)) - 1;
+  return count + bitCount(block_->occupied[word] & below);
+}
+
+std::uint32_t TileBlock::start(unsigned rank) const {
+  const auto* base = reinterpret_cast<const unsigned char*>(block_ + 1);
+  if (block_->wide != 0) {
+    std::uint32_t value;
+    std::memcpy(&value, base + 4 * std::size_t{rank}, 4);
+    return value;
+  }
+  std::uint16_t value;
+  std::memcpy(&value, base + 2 * std::size_t{rank}, 2);
+  return value;
+}
+
+std::uint32_t TileBlock::positiveCount(unsigned rank) const {
+  const std::uint32_t n = block_->num_cells;
+  const auto* base = reinterpret_cast<const unsigned char*>(block_ + 1);
+  if (block_->wide != 0) {
+    std::uint32_t value;
+    std::memcpy(&value, base + 4 * (std::size_t{n} + 1 + rank), 4);
+    return value;
+  }
+  return base[2 * (std::size_t{n} + 1) + rank];
+}
+
+const Volume* TileBlock::volumes() const {
+  return reinterpret_cast<const Volume*>(reinterpret_cast<const unsigned char*>(block_) +
+                                         volumesOffset(block_->num_cells, block_->wide != 0));
+}
+
+ColumnRef TileBlock::column(unsigned local) const {
+  if (!holds(local)) return {};
+  return columnAtRank(rank(local));
+}
+
+ColumnRef TileBlock::columnAtRank(unsigned r) const {
+  const std::uint32_t first = start(r);
+  const std::uint32_t end = start(r + 1);
+  const std::uint32_t num_positive = positiveCount(r);
+  const Volume* list = volumes() + first;
+  return {list, num_positive, list + num_positive, end - first - num_positive};
+}
+
+Volume* TileBlock::mutableVolumes(unsigned local) {
+  return const_cast<Volume*>(volumes()) + start(rank(local));
+}
+
+std::uint32_t TileBlock::numPositive() const {
+  std::uint32_t total = 0;
+  for (std::uint32_t r = 0; r < numCells(); ++r) total += positiveCount(r);
+  return total;
+}
+
+void TileBlock::scaleMasses(double factor, std::int32_t exponent) {
+  if (block_ == nullptr) return;
+  Volume* all = const_cast<Volume*>(volumes());
+  for (std::uint32_t k = 0; k < block_->num_volumes; ++k) {
+    all[k].mass = static_cast<float>(all[k].mass * factor);
+  }
+  block_->exponent = exponent;
+}
+
+void TileBlock::rebaseExponent(std::int64_t offset, std::int64_t max_lag) {
+  if (block_ == nullptr) return;
+  block_->exponent =
+      static_cast<std::int32_t>(std::min(std::int64_t{block_->exponent} - offset, max_lag));
+}
+
+void TileBlock::Builder::add(unsigned local, const ColumnRef& column, double mass_scale) {
+  locals_.push_back(static_cast<std::uint16_t>(local));
+  starts_.push_back(static_cast<std::uint32_t>(volumes_.size()));
+  num_positive_.push_back(column.num_positive);
+  for (const auto& [list, count] :
+       {std::make_pair(column.positive, column.num_positive),
+        std::make_pair(column.negative, column.num_negative)}) {
+    for (std::uint32_t k = 0; k < count; ++k) {
+      Volume v = list[k];
+      if (mass_scale != 1.0) v.mass = static_cast<float>(v.mass * mass_scale);
+      volumes_.push_back(v);
+    }
+  }
+}
+
+void TileBlock::Builder::add(unsigned local, const std::vector<Volume>& positive,
+                             const std::vector<Volume>& negative) {
+  locals_.push_back(static_cast<std::uint16_t>(local));
+  starts_.push_back(static_cast<std::uint32_t>(volumes_.size()));
+  num_positive_.push_back(static_cast<std::uint32_t>(positive.size()));
+  volumes_.insert(volumes_.end(), positive.begin(), positive.end());
+  volumes_.insert(volumes_.end(), negative.begin(), negative.end());
+}
+
+TileBlock TileBlock::Builder::finish(std::int32_t exponent, std::uint64_t modified_revision) {
+  TileBlock tile;
+  const auto num_cells = static_cast<std::uint32_t>(locals_.size());
+  if (num_cells > 0) {
+    const auto num_volumes = static_cast<std::uint32_t>(volumes_.size());
+    const bool wide =
+        num_volumes > std::numeric_limits<std::uint16_t>::max() ||
+        *std::max_element(num_positive_.begin(), num_positive_.end()) >
+            std::numeric_limits<std::uint8_t>::max();
+    const std::size_t offset = volumesOffset(num_cells, wide);
+    void* memory = std::malloc(offset + std::size_t{num_volumes} * sizeof(Volume));
+    if (memory == nullptr) throw std::bad_alloc();
+    tile.block_ = static_cast<Header*>(memory);
+    Header& header = *tile.block_;
+    std::memset(header.occupied, 0, sizeof(header.occupied));
+    header.modified_revision = modified_revision;
+    header.exponent = exponent;
+    header.num_volumes = num_volumes;
+    header.num_cells = static_cast<std::uint16_t>(num_cells);
+    header.wide = wide ? 1 : 0;
+    auto* base = reinterpret_cast<unsigned char*>(tile.block_ + 1);
+    starts_.push_back(num_volumes);
+    for (std::uint32_t r = 0; r < num_cells; ++r) {
+      header.occupied[locals_[r] >> 6] |= std::uint64_t{1} << (locals_[r] & 63);
+    }
+    for (std::uint32_t r = 0; r <= num_cells; ++r) {
+      if (wide) {
+        std::memcpy(base + 4 * std::size_t{r}, &starts_[r], 4);
+      } else {
+        const auto value = static_cast<std::uint16_t>(starts_[r]);
+        std::memcpy(base + 2 * std::size_t{r}, &value, 2);
+      }
+    }
+    for (std::uint32_t r = 0; r < num_cells; ++r) {
+      if (wide) {
+        std::memcpy(base + 4 * (std::size_t{num_cells} + 1 + r), &num_positive_[r], 4);
+      } else {
+        base[2 * (std::size_t{num_cells} + 1) + r] = static_cast<unsigned char>(num_positive_[r]);
+      }
+    }
+    if (num_volumes > 0) {
+      std::memcpy(static_cast<unsigned char*>(memory) + offset, volumes_.data(),
+                  std::size_t{num_volumes} * sizeof(Volume));
+    }
+  }
+  locals_.clear();
+  starts_.clear();
+  num_positive_.clear();
+  volumes_.clear();
+  return tile;
+}
+
+}  // namespace detail
+}  // namespace mvog

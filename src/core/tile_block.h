@@ -1,0 +1,128 @@
+// The storage of one tile of the map (internal to the core): the two volume lists of every cell
+// of a 16 x 16 block of cells, in one heap block.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "mvog/cell_index.h"
+#include "mvog/volume.h"
+
+namespace mvog {
+namespace detail {
+
+constexpr int kTileSizeLog2 = 4;
+constexpr int kTileSize = 1 << kTileSizeLog2;  ///< cells per tile edge
+constexpr int kCellsPerTile = kTileSize * kTileSize;
+
+/// The index of a cell within its tile: row-major, rows along +x.
+inline unsigned localIndex(const CellIndex& c) {
+  constexpr std::int32_t kMask = kTileSize - 1;
+  return static_cast<unsigned>((c.y & kMask) * kTileSize + (c.x & kMask));
+}
+
+/// A tile (x, y) as one hash key, and back: the only place tile keys are packed and unpacked.
+inline std::uint64_t tileKey(std::int32_t tile_x, std::int32_t tile_y) {
+  return (std::uint64_t{static_cast<std::uint32_t>(tile_x)} << 32) |
+         static_cast<std::uint32_t>(tile_y);
+}
+inline std::int32_t tileKeyX(std::uint64_t key) { return static_cast<std::int32_t>(key >> 32); }
+inline std::int32_t tileKeyY(std::uint64_t key) { return static_cast<std::int32_t>(key); }
+inline std::uint64_t tileKeyOf(const CellIndex& c) {
+  return tileKey(c.x >> kTileSizeLog2, c.y >> kTileSizeLog2);  // arithmetic shifts floor
+}
+inline CellIndex tileOrigin(std::uint64_t key) {
+  return {tileKeyX(key) * kTileSize, tileKeyY(key) * kTileSize};
+}
+
+/// A cell's two lists, as stored (masses in the tile's unit).
+struct ColumnRef {
+  const Volume* positive = nullptr;
+  std::uint32_t num_positive = 0;
+  const Volume* negative = nullptr;
+  std::uint32_t num_negative = 0;
+  bool empty() const { return num_positive + num_negative == 0; }
+};
+
+/// One tile: [header | starts | positive counts | volumes] in a single allocation. Only the
+/// cells holding a volume have an entry (found by the rank of their bit in the header's
+/// bitmap), so an unobserved cell costs one bit: a 2D laser map fills its tiles in a thin band.
+/// A cell's volumes are its positive list, then its negative list. Starts and positive counts
+/// are 16 and 8 bits wide, or 32 bits in the rare tile whose volumes need it.
+class TileBlock {
+ public:
+  TileBlock() = default;
+  ~TileBlock();
+  TileBlock(TileBlock&& other) noexcept : block_(other.block_) { other.block_ = nullptr; }
+  TileBlock& operator=(TileBlock&& other) noexcept;
+  TileBlock(const TileBlock&) = delete;
+  TileBlock& operator=(const TileBlock&) = delete;
+
+  bool empty() const { return block_ == nullptr; }
+  /// The lists of cell `local` (empty for a cell without volumes).
+  ColumnRef column(unsigned local) const;
+  /// The lists of the cell of the given rank among those holding volumes (in local order).
+  ColumnRef columnAtRank(unsigned rank) const;
+  /// Where the volumes of cell `local` (which holds some) are stored: to change them in place,
+  /// keeping their number.
+  Volume* mutableVolumes(unsigned local);
+  bool holds(unsigned local) const {
+    return block_ != nullptr && ((block_->occupied[local >> 6] >> (local & 63)) & 1u) != 0;
+  }
+  std::size_t bytes() const;
+  std::uint32_t numCells() const { return block_ == nullptr ? 0 : block_->num_cells; }
+  std::uint32_t numVolumes() const { return block_ == nullptr ? 0 : block_->num_volumes; }
+  /// Positive volumes of the whole tile.
+  std::uint32_t numPositive() const;
+
+  /// The map's mass exponent when the tile was written (see Map::decay).
+  std::int32_t exponent() const { return block_ == nullptr ? 0 : block_->exponent; }
+  /// The map revision at which a volume of the tile last changed.
+  std::uint64_t modifiedRevision() const { return block_ == nullptr ? 0 : block_->modified_revision; }
+  void setModifiedRevision(std::uint64_t revision) {
+    if (block_ != nullptr) block_->modified_revision = revision;
+  }
+  /// Multiplies every mass by `factor` and takes `exponent` (after a decay step, Map::decay).
+  void scaleMasses(double factor, std::int32_t exponent);
+  /// Moves the exponent by -offset, clamped so it stays within 32 bits (Map::decay's rebase).
+  void rebaseExponent(std::int64_t offset, std::int64_t max_lag);
+
+  /// Builds tiles: add the cells that hold volumes in increasing local index, then finish().
+  class Builder {
+   public:
+    /// Appends a cell; its masses are multiplied by `mass_scale` (a power of two, or 1).
+    void add(unsigned local, const ColumnRef& column, double mass_scale);
+    void add(unsigned local, const std::vector<Volume>& positive,
+             const std::vector<Volume>& negative);
+    /// The tile of the cells added (empty if none), which the builder then forgets.
+    TileBlock finish(std::int32_t exponent, std::uint64_t modified_revision);
+
+   private:
+    std::vector<std::uint16_t> locals_;
+    std::vector<std::uint32_t> starts_;
+    std::vector<std::uint32_t> num_positive_;
+    std::vector<Volume> volumes_;
+  };
+
+ private:
+  struct Header {
+    std::uint64_t occupied[kCellsPerTile / 64];  // bit k: cell k holds a volume
+    std::uint64_t modified_revision;
+    std::int32_t exponent;
+    std::uint32_t num_volumes;
+    std::uint16_t num_cells;
+    std::uint8_t wide;  // 32-bit starts and positive counts
+  };
+  /// Rank of cell `local` among the cells with volumes (its bit must be set).
+  unsigned rank(unsigned local) const;
+  std::uint32_t start(unsigned rank) const;
+  std::uint32_t positiveCount(unsigned rank) const;
+  const Volume* volumes() const;
+  static std::size_t volumesOffset(std::uint32_t num_cells, bool wide);
+
+  Header* block_ = nullptr;
+};
+
+}  // namespace detail
+}  // namespace mvog

@@ -1,0 +1,184 @@
+// A plain reference of the scan update of Fig. 2, written from the paper's text and the README's
+// decisions table without any of the map's speed-ups (scan-local scratch tiles, inline slots,
+// the covered-free-space shortcut, tiles written in place): every reading's volumes per cell
+// (eqs. 3-6), collected for the whole scan, joined per cell, clipped around the scan's hits, then
+// merged into the cell's lists by ListMerger (whose rules test_volume.cpp checks one by one).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "mvog/constraints.h"
+#include "mvog/map.h"
+#include "mvog/raster.h"
+
+namespace mvog {
+namespace test {
+
+class ReferenceModel {
+ public:
+  using Cells = std::map<std::pair<std::int32_t, std::int32_t>, CellVolumes>;
+
+  explicit ReferenceModel(const MapConfig& config) : config_(config) {}
+
+  /// Inserts a scan whose readings are all finite and within max_coordinate.
+  void insertScan(const Scan& scan, const InsertionConfig& insertion = {}) {
+    const double s = 1.0 / config_.resolution;
+    const Eigen::Vector3d start = scan.origin * s;
+    std::map<std::pair<std::int32_t, std::int32_t>, std::pair<std::vector<Volume>, std::vector<Volume>>>
+        seen;  // per cell: the scan's free volumes, its hits' volumes
+    auto reading = [&](const Eigen::Vector3f& point, bool is_obstacle) {
+      const Eigen::Vector3d ray = point.cast<double>() - scan.origin;
+      const double length = ray.norm();
+      if (length == 0.0) return;
+      const bool obstacle = is_obstacle && length <= insertion.max_range;
+      const Eigen::Vector3d end =
+          (length > insertion.max_range ? Eigen::Vector3d(scan.origin + ray * (insertion.max_range / length))
+                                        : point.cast<double>()) *
+          s;
+      const auto end_z = static_cast<float>(end.z());
+      walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
+              [&](const CellIndex& c, double z_enter, double z_exit, bool is_last) {
+                auto& [free, hits] = seen[{c.x, c.y}];
+                if (!is_last || !obstacle) {
+                  free.push_back(makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
+                  return;
+                }
+                const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
+                hits.push_back(hit);
+                if (std::fabs(z_enter - end.z()) > 1.0) {
+                  free.push_back(makeVolume(static_cast<float>(z_enter),
+                                            z_enter < end.z() ? hit.bottom : hit.top));
+                }
+              });
+    };
+    for (const Eigen::Vector3f& hit : scan.hits) reading(hit, true);
+    for (const Eigen::Vector3f& end : scan.out_of_range) reading(end, false);
+
+    const ModelRules& rules = config_.rules;
+    const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
+    const float join_gap = per_scan ? kMaxMergeGap : 0.0f;
+    for (auto& [key, lists] : seen) {
+      const std::vector<Volume> free = joined(lists.first, join_gap, per_scan);
+      const std::vector<Volume> hits = joined(lists.second, join_gap, per_scan);
+      std::vector<Volume> added_free;
+      for (const Volume& f : free) {
+        if (!rules.clip_free_space_at_hits) {
+          added_free.push_back(f);
+          continue;
+        }
+        // What of f no hit of the scan covers, in parts at least 1 high.
+        std::vector<std::pair<float, float>> parts{{f.bottom, f.top}};
+        for (const Volume& h : hits) {
+          std::vector<std::pair<float, float>> rest;
+          for (const auto& [b, t] : parts) {
+            if (h.top <= b || h.bottom >= t) {
+              rest.emplace_back(b, t);
+              continue;
+            }
+            if (h.bottom > b) rest.emplace_back(b, h.bottom);
+            if (h.top < t) rest.emplace_back(h.top, t);
+          }
+          parts = rest;
+        }
+        for (const auto& [b, t] : parts) {
+          if (t - b < kMinVolumeHeight) continue;
+          const double mass = per_scan ? static_cast<double>(t) - b
+                                       : (b == f.bottom && t == f.top)
+                                             ? f.mass
+                                             : f.mass * (static_cast<double>(t) - b) /
+                                                   (static_cast<double>(f.top) - f.bottom);
+          added_free.push_back({b, t, static_cast<float>(mass)});
+        }
+      }
+      CellVolumes& cell = cells_[key];
+      std::vector<Volume> positive;
+      std::vector<Volume> negative;
+      ListMerger merger;
+      merger.merge(cell.positive, hits, {}, {}, 1.0f, positive);
+      merger.merge(cell.negative, added_free, positive,
+                   {rules.split_free_space_at_obstacles, rules.clip_free_space_at_hits}, 1.0f,
+                   negative);
+      cell.positive = positive;
+      cell.negative = negative;
+      if (cell.positive.empty() && cell.negative.empty()) cells_.erase(key);
+    }
+  }
+
+  const Cells& cells() const { return cells_; }
+
+ private:
+  /// The union of `volumes` where they are at most `join_gap` apart, each part with the summed
+  /// masses (or, per scan, its height: density 1).
+  static std::vector<Volume> joined(std::vector<Volume> volumes, float join_gap, bool per_scan) {
+    std::sort(volumes.begin(), volumes.end(),
+              [](const Volume& a, const Volume& b) { return a.bottom < b.bottom; });
+    std::vector<Volume> out;
+    std::vector<double> masses;
+    for (const Volume& v : volumes) {
+      if (!out.empty() && v.bottom - out.back().top <= join_gap) {
+        out.back().top = std::max(out.back().top, v.top);
+        masses.back() += v.mass;
+      } else {
+        out.push_back(v);
+        masses.push_back(v.mass);
+      }
+    }
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      out[k].mass = static_cast<float>(per_scan ? out[k].height() : masses[k]);
+    }
+    return out;
+  }
+
+  MapConfig config_;
+  Cells cells_;
+};
+
+/// The map holds exactly the reference's cells and lists: the same bounds bit for bit, masses
+/// within a relative 1e-5 (the map sums some masses in another order).
+inline ::testing::AssertionResult sameAsReference(const Map& map, const ReferenceModel& reference) {
+  std::size_t cells = 0;
+  for (const auto& [key, expected] : reference.cells()) {
+    ++cells;
+    const CellVolumes held = map.cellVolumes({key.first, key.second});
+    for (bool positive : {true, false}) {
+      const std::vector<Volume>& a = positive ? held.positive : held.negative;
+      const std::vector<Volume>& b = positive ? expected.positive : expected.negative;
+      bool same = a.size() == b.size();
+      for (std::size_t k = 0; same && k < a.size(); ++k) {
+        same = a[k].bottom == b[k].bottom && a[k].top == b[k].top &&
+               std::fabs(a[k].mass - b[k].mass) <= 1e-5f * std::max(1.0f, b[k].mass);
+      }
+      if (!same) {
+        std::ostringstream text;
+        text << "cell (" << key.first << ", " << key.second << ") "
+             << (positive ? "positive" : "negative") << ": map";
+        for (const Volume& v : a) text << " [" << v.bottom << ", " << v.top << " | " << v.mass << "]";
+        text << ", reference";
+        for (const Volume& v : b) text << " [" << v.bottom << ", " << v.top << " | " << v.mass << "]";
+        return ::testing::AssertionFailure() << text.str();
+      }
+    }
+  }
+  std::size_t map_cells = 0;
+  map.forEachVolume([&, last = CellIndex{0, 0}, first = true](const CellIndex& c, VolumeSign,
+                                                               const Volume&) mutable {
+    if (first || c != last) ++map_cells;
+    first = false;
+    last = c;
+  });
+  if (map_cells != cells) {
+    return ::testing::AssertionFailure() << "the map has " << map_cells
+                                         << " cells with volumes, the reference " << cells;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace test
+}  // namespace mvog
