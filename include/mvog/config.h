@@ -24,6 +24,9 @@ enum class MassCounting : std::uint8_t {
   kPerScan,
 };
 
+/// The default of ModelRules::out_of_range_free_length (m), chosen by measurement (BENCHMARKS.md).
+constexpr double kDefaultOutOfRangeFreeLength = 5.0;
+
 /// The rules of the model where it departs from the paper's text (the README's decisions table).
 /// ModelRules::paper() is the paper's exact model; the defaults are the measured best.
 struct ModelRules {
@@ -36,13 +39,22 @@ struct ModelRules {
   /// the free space seen within an obstacle's heights keeps its own density in eq. (9) instead
   /// of the average over the whole free column (which erases surfaces under dense free space).
   bool split_free_space_at_obstacles = true;
+  /// An out-of-range reading (no return) frees its ray only this far from the sensor (m): a
+  /// dark or glancing surface returns nothing too, so a ray without a return may have crossed a
+  /// wall the sensor did not see, and a long one (80 m for a SICK) costs a long walk. Hits
+  /// truncated by InsertionConfig::max_range are returns: they keep their free space up to it.
+  /// Infinity (the paper): up to the reading's end.
+  double out_of_range_free_length = kDefaultOutOfRangeFreeLength;
 
   /// The model exactly as the paper describes it.
-  static ModelRules paper() { return {false, MassCounting::kPerReading, false}; }
+  static ModelRules paper() {
+    return {false, MassCounting::kPerReading, false, std::numeric_limits<double>::infinity()};
+  }
   friend bool operator==(const ModelRules& a, const ModelRules& b) {
     return a.clip_free_space_at_hits == b.clip_free_space_at_hits &&
            a.mass_counting == b.mass_counting &&
-           a.split_free_space_at_obstacles == b.split_free_space_at_obstacles;
+           a.split_free_space_at_obstacles == b.split_free_space_at_obstacles &&
+           a.out_of_range_free_length == b.out_of_range_free_length;
   }
 };
 

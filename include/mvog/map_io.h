@@ -16,17 +16,22 @@ class MapFileError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The binary map format, version 1. Everything little-endian, no padding:
+/// The binary map format, version 2. Everything little-endian, no padding:
 ///
 ///   offset  size  field
 ///        0     8  magic "MVOGMAP\0"
-///        8     4  uint32 format version (1)
+///        8     4  uint32 format version (2; 1 is read too)
 ///       12     4  uint32 header size in bytes (64)
 ///       16     8  float64 resolution (m)
 ///       24     8  float64 max_coordinate (m)
 ///       32     8  uint64 number of cells C (cells holding at least one volume)
 ///       40     8  uint64 number of volumes V (positive and negative)
-///       48    16  reserved, zero
+///       48     4  uint32 the model's rules (ModelRules): bit 0 clip_free_space_at_hits,
+///                 bit 1 mass_counting per scan, bit 2 split_free_space_at_obstacles; the other
+///                 bits zero
+///       52     8  float64 ModelRules::out_of_range_free_length (m, may be infinite)
+///       60     4  reserved, zero
+/// Version 1 had 16 reserved bytes (zero) at 48: the paper's model.
 ///       64     .  C cells, each: int32 x, int32 y, uint32 n_positive, uint32 n_negative,
 ///                 then n_positive + n_negative volumes (float32 bottom, top, mass; heights in
 ///                 grid units, positive list first, each list sorted upwards)
@@ -34,7 +39,7 @@ class MapFileError : public std::runtime_error {
 ///
 /// The file size must equal 64 + 16 C + 12 V + 8, which bounds every count before anything is
 /// allocated. Masses are the masses as of saving (decay folded in).
-constexpr std::uint32_t kMapFormatVersion = 1;
+constexpr std::uint32_t kMapFormatVersion = 2;
 constexpr std::size_t kMapHeaderBytes = 64;
 
 std::vector<std::uint8_t> serializeMap(const Map& map);

@@ -1,6 +1,7 @@
 #include "mvog/column.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace mvog {
 
@@ -24,10 +25,10 @@ std::vector<ColumnSegment> columnProfile(const CellVolumes& volumes) {
         volumes.positive.data(), static_cast<std::uint32_t>(volumes.positive.size()), middle);
     const Volume* negative = findVolume(
         volumes.negative.data(), static_cast<std::uint32_t>(volumes.negative.size()), middle);
-    const float rho_plus = positive != nullptr ? positive->density() : 0.0f;
-    const float rho_minus = negative != nullptr ? negative->density() : 0.0f;
-    if (!(rho_plus + rho_minus > 0.0f)) continue;  // a gap between volumes: unknown
-    const float probability = rho_plus / (rho_plus + rho_minus);
+    const float probability =
+        occupancyProbability(positive != nullptr ? positive->density() : 0.0f,
+                             negative != nullptr ? negative->density() : 0.0f);
+    if (std::isnan(probability)) continue;  // a gap between volumes: unknown
     if (!segments.empty() && segments.back().top == heights[k] &&
         segments.back().probability == probability) {
       segments.back().top = heights[k + 1];

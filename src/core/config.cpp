@@ -19,6 +19,8 @@ void MapConfig::validate() const {
   // Heights are floats in grid units: keep them below 2^22 so that they resolve a quarter cell.
   require(max_coordinate / resolution <= 4194304.0, "max_coordinate",
           "must be at most 4194304 cells (max_coordinate / resolution)");
+  require(!std::isnan(rules.out_of_range_free_length) && rules.out_of_range_free_length > 0.0,
+          "out_of_range_free_length", "must be > 0 (infinity for no limit)");
 }
 
 void InsertionConfig::validate() const {

@@ -92,6 +92,27 @@ class Reader {
 
 [[noreturn]] void fail(const std::string& what) { throw MapFileError("invalid map: " + what); }
 
+constexpr std::uint32_t kClipBit = 1u << 0;
+constexpr std::uint32_t kPerScanBit = 1u << 1;
+constexpr std::uint32_t kSplitBit = 1u << 2;
+constexpr std::uint32_t kAllRuleBits = kClipBit | kPerScanBit | kSplitBit;
+
+std::uint32_t rulesBits(const ModelRules& rules) {
+  return (rules.clip_free_space_at_hits ? kClipBit : 0u) |
+         (rules.mass_counting == MassCounting::kPerScan ? kPerScanBit : 0u) |
+         (rules.split_free_space_at_obstacles ? kSplitBit : 0u);
+}
+
+/// Version 1 (no field, zero) is the paper's model.
+ModelRules rulesOf(std::uint32_t bits) {
+  ModelRules rules = ModelRules::paper();
+  rules.clip_free_space_at_hits = (bits & kClipBit) != 0;
+  rules.mass_counting =
+      (bits & kPerScanBit) != 0 ? MassCounting::kPerScan : MassCounting::kPerReading;
+  rules.split_free_space_at_obstacles = (bits & kSplitBit) != 0;
+  return rules;
+}
+
 std::string systemError(const std::string& what, const std::string& path) {
   return what + " '" + path + "': " + std::strerror(errno);
 }
@@ -124,8 +145,9 @@ std::vector<std::uint8_t> serializeMap(const Map& map) {
   writer.f64(map.config().max_coordinate);
   writer.u64(cells.size());
   writer.u64(volume_count);
-  writer.u64(0);
-  writer.u64(0);
+  writer.u32(rulesBits(map.config().rules));
+  writer.f64(map.config().rules.out_of_range_free_length);
+  writer.u32(0);
   for (const CellRecord& record : cells) {
     writer.i32(record.cell.x);
     writer.i32(record.cell.y);
@@ -150,8 +172,8 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   if (std::memcmp(data, kMagic, sizeof(kMagic)) != 0) fail("not an MVOG map (bad magic)");
   Reader header(data, sizeof(kMagic));
   const std::uint32_t version = header.u32();
-  if (version != kMapFormatVersion) {
-    fail("format version " + std::to_string(version) + " is not supported (expected " +
+  if (version != kMapFormatVersion && version != 1) {
+    fail("format version " + std::to_string(version) + " is not supported (expected 1 or " +
          std::to_string(kMapFormatVersion) + ")");
   }
   if (header.u32() != kMapHeaderBytes) fail("unexpected header size");
@@ -160,7 +182,15 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   config.max_coordinate = header.f64();
   const std::uint64_t cell_count = header.u64();
   const std::uint64_t volume_count = header.u64();
-  if (header.u64() != 0 || header.u64() != 0) fail("reserved header bytes are not zero");
+  const std::uint32_t rules = header.u32();
+  if (rules & ~kAllRuleBits) fail("unknown bits in the model's rules");
+  config.rules = rulesOf(rules);
+  if (version == 1) {
+    if (header.u64() != 0 || header.u32() != 0) fail("reserved header bytes are not zero");
+  } else {
+    config.rules.out_of_range_free_length = header.f64();
+    if (header.u32() != 0) fail("reserved header bytes are not zero");
+  }
   // Check the counts against the real size before trusting them for anything.
   const std::size_t body = size - kMapHeaderBytes - kChecksumBytes;
   if (cell_count > body / kCellRecordBytes || volume_count > body / sizeof(Volume) ||
@@ -184,6 +214,8 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   Reader reader(data, kMapHeaderBytes);
   std::unordered_set<std::uint64_t> seen;
   std::uint64_t volumes_read = 0;
+  std::vector<Map::CellAssignment> assignments;
+  assignments.reserve(cell_count);
   for (std::uint64_t c = 0; c < cell_count; ++c) {
     const CellIndex cell{reader.i32(), reader.i32()};
     const std::uint64_t num_positive = reader.u32();
@@ -197,20 +229,22 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     const std::uint64_t key = (std::uint64_t{static_cast<std::uint32_t>(cell.x)} << 32) |
                               static_cast<std::uint32_t>(cell.y);
     if (!seen.insert(key).second) fail(where + " appears twice");
-    CellVolumes volumes;
+    Map::CellAssignment& assignment = assignments.emplace_back();
+    assignment.cell = cell;
+    CellVolumes& volumes = assignment.volumes;
     volumes.positive.resize(num_positive);
     volumes.negative.resize(num_negative);
     for (std::vector<Volume>* list : {&volumes.positive, &volumes.negative}) {
       for (Volume& v : *list) v = Volume{reader.f32(), reader.f32(), reader.f32()};
     }
     volumes_read += num_positive + num_negative;
-    try {
-      map.setCellVolumes(cell, volumes);  // checks the constraints and max_coordinate
-    } catch (const ConfigError& e) {
-      fail(where + ": " + e.what());
-    }
   }
   if (volumes_read != volume_count) fail("fewer volumes than the header counts");
+  try {
+    map.setCellVolumes(assignments);  // checks the constraints and max_coordinate
+  } catch (const ConfigError& e) {
+    fail(e.what());
+  }
   return map;
 }
 

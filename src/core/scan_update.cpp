@@ -159,8 +159,9 @@ namespace {
 /// Checks one reading and counts it in `result`; on acceptance sets the ray's end (truncated to
 /// max_range) and whether it ends in an obstacle.
 bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, ReadingKind kind,
-                   double max_coordinate, const InsertionConfig& config, Eigen::Vector3d& ray_end,
-                   bool& obstacle, InsertionResult& result) {
+                   const MapConfig& map_config, const InsertionConfig& config,
+                   Eigen::Vector3d& ray_end, bool& obstacle, InsertionResult& result) {
+  const double max_coordinate = map_config.max_coordinate;
   const bool is_obstacle = kind == ReadingKind::kObstacle;
   if (!origin.allFinite() || !end.allFinite()) {
     ++result.rejected_non_finite;
@@ -183,8 +184,10 @@ bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, Re
     ++result.ignored_out_of_range;
     return false;
   }
-  ray_end =
-      length > config.max_range ? Eigen::Vector3d(origin + ray * (config.max_range / length)) : end;
+  const double free_length =
+      is_obstacle ? config.max_range
+                  : std::min(config.max_range, map_config.rules.out_of_range_free_length);
+  ray_end = length > free_length ? Eigen::Vector3d(origin + ray * (free_length / length)) : end;
   if (obstacle) {
     ++result.obstacle_readings;
   } else {
@@ -232,8 +235,8 @@ void rasterizeReadings(const Scan& scan, std::size_t first, std::size_t last,
   auto add = [&](const Eigen::Vector3f& end, ReadingKind kind) {
     Eigen::Vector3d ray_end;
     bool obstacle = false;
-    if (acceptReading(scan.origin, end.cast<double>(), kind, map_config.max_coordinate, insertion,
-                      ray_end, obstacle, result)) {
+    if (acceptReading(scan.origin, end.cast<double>(), kind, map_config, insertion, ray_end,
+                      obstacle, result)) {
       addReading(start, ray_end * s, obstacle, insertion.model_negative_space, writer);
     }
   };

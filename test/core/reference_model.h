@@ -38,9 +38,13 @@ class ReferenceModel {
       const double length = ray.norm();
       if (length == 0.0) return;
       const bool obstacle = is_obstacle && length <= insertion.max_range;
+      // A ray without a return frees at most out_of_range_free_length.
+      const double free_length =
+          is_obstacle ? insertion.max_range
+                      : std::min(insertion.max_range, config_.rules.out_of_range_free_length);
       const Eigen::Vector3d end =
-          (length > insertion.max_range ? Eigen::Vector3d(scan.origin + ray * (insertion.max_range / length))
-                                        : point.cast<double>()) *
+          (length > free_length ? Eigen::Vector3d(scan.origin + ray * (free_length / length))
+                                : point.cast<double>()) *
           s;
       const auto end_z = static_cast<float>(end.z());
       walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),

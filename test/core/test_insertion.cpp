@@ -736,6 +736,25 @@ TEST(Rules, PerScanTheScansFreeHeightsJoinAcrossGapsOfOne) {
   }
 }
 
+TEST(Rules, ARayWithoutAReturnFreesOnlyItsFirstMetres) {
+  // out_of_range_free_length 5 m: a ray without a return 20 m long frees 5 m; a hit 20 m away
+  // frees its whole ray; with the paper's rule (infinity) the ray without a return frees 20 m.
+  for (const double free_length : {5.0, std::numeric_limits<double>::infinity()}) {
+    ModelRules rules;
+    rules.out_of_range_free_length = free_length;
+    Map map(unitConfig(10000.0, rules));
+    Scan scan;
+    scan.origin = {0.5, 0.5, 0.5};
+    scan.out_of_range.push_back({20.5f, 0.5f, 0.5f});
+    scan.hits.push_back({0.5f, 20.5f, 0.5f});
+    map.insertScan(scan);
+    EXPECT_EQ(map.occupancy({4.5, 0.5, 0.5}).state(0.5), OccupancyState::kFree);
+    EXPECT_EQ(map.occupancy({10.5, 0.5, 0.5}).known(), std::isinf(free_length));
+    EXPECT_EQ(map.occupancy({0.5, 10.5, 0.5}).state(0.5), OccupancyState::kFree);
+    EXPECT_EQ(map.occupancy({0.5, 20.5, 0.5}).state(0.5), OccupancyState::kOccupied);
+  }
+}
+
 TEST(Rules, ARingOfLaserHitsStaysOccupied) {
   // 5 identical scans of 360 beams, every range 4 m, from a laser at (0, 0, 1), cells of 0.1 m:
   // the beams to neighbouring ring cells cross ring cells on their way. With the defaults every

@@ -65,7 +65,8 @@ constexpr std::size_t kResolutionOffset = 16;
 constexpr std::size_t kMaxCoordinateOffset = 24;
 constexpr std::size_t kCellCountOffset = 32;
 constexpr std::size_t kVolumeCountOffset = 40;
-constexpr std::size_t kReservedOffset = 48;
+constexpr std::size_t kRulesOffset = 48;
+constexpr std::size_t kReservedOffset = 60;
 
 struct CellRecord {
   std::int32_t x;
@@ -80,9 +81,12 @@ void fixChecksum(Bytes& file) {
 }
 
 /// A file in the documented layout, with the counts and the checksum filled in.
-Bytes buildFile(double resolution, double max_coordinate, const std::vector<CellRecord>& cells) {
+/// The documented layout, written by hand: version 2 with the rules' bits (0b111 for the defaults:
+/// clip, per scan, split), or version 1 (rules_bits must then be 0).
+Bytes buildFile(double resolution, double max_coordinate, const std::vector<CellRecord>& cells,
+                std::uint32_t version = 2, std::uint32_t rules_bits = 7) {
   Bytes out = {'M', 'V', 'O', 'G', 'M', 'A', 'P', '\0'};
-  appendLe(out, 1, 4);
+  appendLe(out, version, 4);
   appendLe(out, 64, 4);
   appendLe(out, bitsOf(resolution), 8);
   appendLe(out, bitsOf(max_coordinate), 8);
@@ -90,8 +94,9 @@ Bytes buildFile(double resolution, double max_coordinate, const std::vector<Cell
   for (const CellRecord& c : cells) volumes += c.positive.size() + c.negative.size();
   appendLe(out, cells.size(), 8);
   appendLe(out, volumes, 8);
-  appendLe(out, 0, 8);
-  appendLe(out, 0, 8);
+  appendLe(out, rules_bits, 4);
+  appendLe(out, version == 1 ? 0 : bitsOf(kDefaultOutOfRangeFreeLength), 8);
+  appendLe(out, 0, 4);
   for (const CellRecord& c : cells) {
     appendLe(out, static_cast<std::uint32_t>(c.x), 4);
     appendLe(out, static_cast<std::uint32_t>(c.y), 4);
@@ -146,6 +151,29 @@ TEST(MapIo, LayoutIsTheDocumentedOne) {
   const Bytes empty = serializeMap(Map(MapConfig{0.25, 50.0, ModelRules{}}));
   EXPECT_EQ(empty, buildFile(0.25, 50.0, {}));
   EXPECT_EQ(empty.size(), kMapHeaderBytes + 8);
+}
+
+TEST(MapIo, TheModelsRulesTravelWithTheMap) {
+  // A map keeps being built by the rules it was built with: they are in the file.
+  for (const ModelRules& rules : {ModelRules{}, ModelRules::paper()}) {
+    MapConfig config;
+    config.rules = rules;
+    const Bytes bytes = serializeMap(Map(config));
+    EXPECT_TRUE(deserializeMap(bytes.data(), bytes.size()).config().rules == rules);
+  }
+  ModelRules clip_only = ModelRules::paper();
+  clip_only.clip_free_space_at_hits = true;
+  clip_only.out_of_range_free_length = kDefaultOutOfRangeFreeLength;
+  const Bytes file = buildFile(0.5, 100.0, smallCells(), 2, 1);
+  EXPECT_TRUE(deserializeMap(file.data(), file.size()).config().rules == clip_only);
+}
+
+TEST(MapIo, VersionOneFilesAreReadAsThePapersModel) {
+  // Maps saved before the rules existed were built by the paper's model.
+  const Bytes file = buildFile(0.5, 100.0, smallCells(), 1, 0);
+  const Map map = deserializeMap(file.data(), file.size());
+  EXPECT_TRUE(map.config().rules == ModelRules::paper());
+  EXPECT_EQ(test::observedCells(map).size(), 3u);
 }
 
 TEST(MapIo, SerializeDeserializeIsTheIdentity) {
@@ -384,7 +412,7 @@ TEST(MapIo, RefusesBadMagicVersionAndHeaderSize) {
   bad[7] = '1';
   fixChecksum(bad);
   EXPECT_TRUE(refused(bad));
-  for (std::uint32_t version : {0u, 2u, 0xffffffffu}) {
+  for (std::uint32_t version : {0u, 3u, 0xffffffffu}) {
     bad = file;
     putLe(bad, kVersionOffset, version, 4);
     fixChecksum(bad);
@@ -397,7 +425,11 @@ TEST(MapIo, RefusesBadMagicVersionAndHeaderSize) {
     EXPECT_TRUE(refused(bad)) << "header size " << header_size;
   }
   bad = file;
-  bad[kReservedOffset + 9] = 1;
+  bad[kReservedOffset + 1] = 1;
+  fixChecksum(bad);
+  EXPECT_TRUE(refused(bad));
+  bad = file;
+  putLe(bad, kRulesOffset, 8, 4);  // a rule this version does not know
   fixChecksum(bad);
   EXPECT_TRUE(refused(bad));
 }
