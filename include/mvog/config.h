@@ -25,7 +25,7 @@ enum class MassCounting : std::uint8_t {
 };
 
 /// The default of ModelRules::out_of_range_free_length (m), chosen by measurement (BENCHMARKS.md).
-constexpr double kDefaultOutOfRangeFreeLength = 5.0;
+constexpr double kDefaultOutOfRangeFreeLength = 2.0;
 
 /// The rules of the model where it departs from the paper's text (the README's decisions table).
 /// ModelRules::paper() is the paper's exact model; the defaults are the measured best.

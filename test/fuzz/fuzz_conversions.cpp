@@ -9,7 +9,8 @@
 // Input layout (little-endian, read from the front; missing bytes read as zero), also written by
 // test/fuzz/make_seeds.py:
 //   u8  kind            bit 0: 0 LaserScan, 1 PointCloud2
-//   u8  options         bit 0: insert the readings into a map, bit 1: clear_conflicting_free_space,
+//   u8  options         bit 0: insert the readings into a map, bit 1: the paper's model (else the
+//                       default rules),
 //                       bit 2: no negative space, bit 3: two insertion threads
 //   f32 x, y, z, roll, pitch, yaw      sensor pose (non-finite -> 0, translation clamped to 40 m)
 //   LaserScan:   f32 angle_min, angle_max, angle_increment, range_min, range_max, max_free_range,
@@ -174,9 +175,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   mvog::MapConfig map_config;
   map_config.resolution = 1.0;
   map_config.max_coordinate = 32.0;  // keeps the rays of a fuzz input short
+  if ((options & 2) != 0) map_config.rules = mvog::ModelRules::paper();
   mvog::Map map(map_config);
   mvog::InsertionConfig insertion;
-  insertion.clear_conflicting_free_space = (options & 2) != 0;
   insertion.model_negative_space = (options & 4) == 0;
   insertion.insertion_threads = (options & 8) != 0 ? 2 : 1;
   const mvog::InsertionResult result = map.insertScan(readings, insertion);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <random>
 #include <sstream>
 #include <unordered_set>
@@ -54,8 +53,16 @@ MvogRun runMvog(const InputData& input, const RunOptions& options) {
   MvogRun run{mvog::Map(map_config), {}};
   MvogStats& stats = run.stats;
   stats.threads = options.threads;
+  std::vector<mvog::Scan> with_out_of_range;
+  if (options.out_of_range) {
+    with_out_of_range = input.scans;
+    for (std::size_t k = 0; k < input.scans.size(); ++k) {
+      with_out_of_range[k].out_of_range = input.out_of_range[k];
+    }
+  }
+  const std::vector<mvog::Scan>& scans = options.out_of_range ? with_out_of_range : input.scans;
   const auto start = std::chrono::steady_clock::now();
-  for (const mvog::Scan& scan : input.scans) stats.insertion += run.map.insertScan(scan, insertion);
+  for (const mvog::Scan& scan : scans) stats.insertion += run.map.insertScan(scan, insertion);
   stats.insert_seconds = secondsSince(start);
   stats.memory = run.map.memoryUsage();
   const std::vector<std::uint8_t> file = mvog::serializeMap(run.map);
@@ -280,41 +287,6 @@ Quality qualityOf(const SamplePoints& points, StateOf&& state_of) {
 }  // namespace
 
 Quality mvogQuality(const mvog::Map& map, double occupancy_threshold, const SamplePoints& points) {
-  if (std::getenv("MVOG_DEBUG")) {
-    std::size_t shown = 0, bad = 0;
-    std::map<std::string, std::size_t> hist;
-    for (const Eigen::Vector3d& p : points.endpoints) {
-      const mvog::PointOccupancy o = map.occupancy(p);
-      if (o.state(occupancy_threshold) == mvog::OccupancyState::kOccupied) continue;
-      ++bad;
-      const mvog::CellIndex c = map.cellAtPoint(p.x(), p.y());
-      const mvog::CellVolumes v = map.cellVolumes(c);
-      const float z = static_cast<float>(p.z() / map.resolution());
-      const mvog::Volume* pos = mvog::findVolume(v.positive.data(), v.positive.size(), z);
-      const mvog::Volume* neg = mvog::findVolume(v.negative.data(), v.negative.size(), z);
-      char key[200];
-      std::snprintf(key, sizeof key, "posh %s negaligned %s ratio %s",
-                    pos ? (pos->height() < 1.5 ? "<1.5" : pos->height() < 3 ? "<3" : ">=3") : "none",
-                    (neg && pos && neg->bottom == pos->bottom && neg->top == pos->top) ? "yes" : "no",
-                    o.negative_density > 3 * o.positive_density ? ">3" : o.negative_density > 1.5 * o.positive_density ? ">1.5" : "<=1.5");
-      ++hist[key];
-      if (shown++ < 12) {
-        std::fprintf(stderr, "z=%.2f rho+ %.3g rho- %.3g | P:", z, o.positive_density, o.negative_density);
-        for (auto& x : v.positive) std::fprintf(stderr, " [%.2f,%.2f|%.2f]", x.bottom, x.top, x.mass);
-        std::fprintf(stderr, " | N:");
-        for (auto& x : v.negative) std::fprintf(stderr, " [%.2f,%.2f|%.2f]", x.bottom, x.top, x.mass);
-        std::fprintf(stderr, "\n");
-      }
-    }
-    std::fprintf(stderr, "bad endpoints %zu of %zu\n", bad, points.endpoints.size());
-    for (double t : {0.5, 0.4, 1.0 / 3.0, 0.25, 0.2}) {
-      std::size_t occ = 0, fr = 0;
-      for (const Eigen::Vector3d& p : points.endpoints) occ += map.occupancy(p).state(t) == mvog::OccupancyState::kOccupied;
-      for (const Eigen::Vector3d& p : points.along_rays) fr += map.occupancy(p).state(t) == mvog::OccupancyState::kFree;
-      std::fprintf(stderr, "threshold %.3f: ends occupied %.1f%% along free %.1f%%\n", t, 100.0 * occ / points.endpoints.size(), 100.0 * fr / points.along_rays.size());
-    }
-    for (auto& [k, n] : hist) std::fprintf(stderr, "  %6zu %s\n", n, k.c_str());
-  }
   return qualityOf(points, [&](const Eigen::Vector3d& p) {
     return map.occupancy(p).state(occupancy_threshold);
   });

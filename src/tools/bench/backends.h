@@ -23,6 +23,8 @@ struct RunOptions {
   mvog::ModelRules rules;
   /// MVOG only: occupied where p is above it.
   double occupancy_threshold = mvog::kDefaultOccupancyThreshold;
+  /// MVOG only: insert the out-of-range readings too (with rules.out_of_range_free_length).
+  bool out_of_range = false;
 };
 
 struct MvogStats {

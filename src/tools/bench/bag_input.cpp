@@ -85,13 +85,17 @@ InputData loadBag(const std::string& path, const std::string& fixed_frame) {
         continue;
       }
       input.out_of_range_readings += readings.out_of_range.size();
-      readings.out_of_range.clear();
+      std::vector<Eigen::Vector3f> out_of_range;
+      out_of_range.swap(readings.out_of_range);
       const std::size_t before = readings.hits.size();
       readings.hits.erase(std::remove_if(readings.hits.begin(), readings.hits.end(),
                                          [](const Eigen::Vector3f& p) { return !p.allFinite(); }),
                           readings.hits.end());
       input.non_finite_points += before - readings.hits.size();
-      if (!readings.hits.empty()) input.scans.push_back(std::move(readings));
+      if (!readings.hits.empty()) {
+        input.scans.push_back(std::move(readings));
+        input.out_of_range.push_back(std::move(out_of_range));
+      }
     }
   } catch (const ros::Exception& e) {  // rosbag::BagException and deserialisation errors
     throw InputError(path + ": cannot read the bag: " + e.what());

@@ -18,16 +18,19 @@ class InputError : public std::runtime_error {
 /// Every scan of an input file, read into memory before anything is timed.
 ///
 /// Both backends see exactly these rays: each scan's origin and its obstacle readings (hits) in
-/// the map frame, single precision. Out-of-range readings are counted but disregarded, as in the
-/// paper's Table I ("Out-of-range sensor readings present in the experiments are disregarded in
-/// all four representations"), so `Scan::out_of_range` is always empty.
+/// the map frame, single precision. Out-of-range readings are kept aside: disregarded by
+/// default, as in the paper's Table I ("Out-of-range sensor readings present in the experiments
+/// are disregarded in all four representations"), so `Scan::out_of_range` is always empty;
+/// given to MVOG alone with mvog_bench --out-of-range-free-length.
 struct InputData {
   std::string format;  ///< "bag" or "graph"
   std::vector<mvog::Scan> scans;
+  /// The out-of-range readings of each scan (at the sensor's range_max).
+  std::vector<std::vector<Eigen::Vector3f>> out_of_range;
   std::size_t sensor_messages = 0;        ///< LaserScan/PointCloud2 messages or graph nodes
   std::size_t without_transform = 0;      ///< messages skipped: no transform to the fixed frame
   std::size_t invalid_messages = 0;       ///< messages skipped: malformed
-  std::size_t out_of_range_readings = 0;  ///< +Inf / beyond range_max: disregarded
+  std::size_t out_of_range_readings = 0;  ///< +Inf / beyond range_max (in out_of_range)
   std::size_t skipped_beams = 0;          ///< NaN, -Inf or below range_min: no information
   std::size_t non_finite_points = 0;      ///< cloud points with a NaN or infinite coordinate
 

@@ -28,7 +28,8 @@ struct Arguments {
   double max_range = std::numeric_limits<double>::infinity();
   int threads = 1;
   mvog::ModelRules rules;
-  std::optional<double> occupancy_threshold;  ///< default: the rules' (the paper's for --model paper)
+  std::optional<double> occupancy_threshold;
+  bool out_of_range = false;  ///< default: the rules' (the paper's for --model paper)
   bool run_mvog = false;
   bool run_octomap = false;
   bool run_walk = false;
@@ -47,6 +48,7 @@ constexpr const char* kUsage =
     "                  [--model default|paper] [--clip-free-space-at-hits on|off]\n"
     "                  [--mass-counting per-scan|per-reading]\n"
     "                  [--split-free-space-at-obstacles on|off] [--occupancy-threshold T]\n"
+    "                  [--out-of-range-free-length L|inf]\n"
     "  FILE        a ROS bag (LaserScan and/or PointCloud2, poses from /tf and /tf_static)\n"
     "              or an OctoMap ScanGraph (.graph)\n"
     "  R           cell size in metres, repeatable (default 0.1)\n"
@@ -57,6 +59,8 @@ constexpr const char* kUsage =
     "  FRAME       the bag's world frame (default map)\n"
     "  T           MVOG is occupied where p > T (default: mvog::kDefaultOccupancyThreshold,\n"
     "              the paper's 0.5 with --model paper)\n"
+    "  L           MVOG also inserts the out-of-range readings, freeing L m of each (OctoMap\n"
+    "              takes none: by default both backends disregard them, as the paper's Table I)\n"
     "  --model     MVOG's rules: the defaults, or the paper's exact model; the options after\n"
     "              it change one rule each (mvog::ModelRules, README's decisions table)\n";
 
@@ -107,6 +111,10 @@ Arguments parseArguments(int argc, char** argv) {
       const double threshold = positiveNumber(option, value);
       if (threshold >= 1.0) throw UsageError("--occupancy-threshold must be in (0, 1)");
       arguments.occupancy_threshold = threshold;
+    } else if (option == "--out-of-range-free-length") {
+      arguments.rules.out_of_range_free_length =
+          value == "inf" ? std::numeric_limits<double>::infinity() : positiveNumber(option, value);
+      arguments.out_of_range = true;
     } else if (option == "--model") {
       if (value != "default" && value != "paper") {
         throw UsageError("--model must be default or paper, got '" + value + "'");
@@ -158,6 +166,7 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   options.threads = arguments.threads;
   options.rules = arguments.rules;
   options.occupancy_threshold = occupancyThreshold(arguments);
+  options.out_of_range = arguments.out_of_range;
   mvog_bench::ResolutionReport report;
   report.resolution = resolution;
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
@@ -212,6 +221,7 @@ int main(int argc, char** argv) {
     report.max_range = arguments.max_range;
     report.rules = arguments.rules;
     report.occupancy_threshold = occupancyThreshold(arguments);
+    report.out_of_range = arguments.out_of_range;
     const auto start = std::chrono::steady_clock::now();
     const mvog_bench::InputData input =
         mvog_bench::loadInput(arguments.input, arguments.fixed_frame);

@@ -173,7 +173,11 @@ std::string rulesText(const mvog::ModelRules& rules) {
   return std::string("clip_free_space_at_hits ") + (rules.clip_free_space_at_hits ? "on" : "off") +
          ", mass_counting " +
          (rules.mass_counting == mvog::MassCounting::kPerScan ? "per-scan" : "per-reading") +
-         ", split_free_space_at_obstacles " + (rules.split_free_space_at_obstacles ? "on" : "off");
+         ", split_free_space_at_obstacles " + (rules.split_free_space_at_obstacles ? "on" : "off") +
+         ", out_of_range_free_length " +
+         (std::isinf(rules.out_of_range_free_length)
+              ? std::string("inf")
+              : std::to_string(rules.out_of_range_free_length).substr(0, 5) + " m");
 }
 
 }  // namespace
@@ -184,9 +188,10 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                input.format.c_str(), report.load_seconds);
   std::fprintf(out,
                "readings    %zu obstacle readings in %zu scans (of %zu sensor messages); "
-               "disregarded: %zu out-of-range, %zu invalid beams, %zu non-finite points; "
+               "out-of-range: %zu (%s); disregarded: %zu invalid beams, %zu non-finite points; "
                "skipped messages: %zu without transform, %zu malformed\n",
                readings, input.scans.size(), input.sensor_messages, input.out_of_range_readings,
+               report.out_of_range ? "given to MVOG only" : "disregarded by both backends",
                input.skipped_beams, input.non_finite_points, input.without_transform,
                input.invalid_messages);
   if (std::isfinite(report.max_range)) {
@@ -366,6 +371,7 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
       .add("input", input_json)
       .add("max_range", report.max_range)
       .add("rules", rulesText(report.rules))
+      .add("out_of_range_to_mvog", report.out_of_range)
       .add("occupancy_threshold", report.occupancy_threshold)
       .add("table_one", table_one)
       .add("quality", quality)

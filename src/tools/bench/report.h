@@ -28,6 +28,7 @@ struct BenchReport {
   double max_range = 0.0;  ///< infinity: none
   mvog::ModelRules rules;
   double occupancy_threshold = 0.0;
+  bool out_of_range = false;  ///< the out-of-range readings were given to MVOG
   std::vector<ResolutionReport> resolutions;
 };
 

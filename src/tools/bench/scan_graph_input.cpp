@@ -122,6 +122,7 @@ InputData loadScanGraph(const std::string& path) {
       scan.hits.push_back((world_from_sensor * point).cast<float>());
     }
     input.scans.push_back(std::move(scan));
+    input.out_of_range.emplace_back();  // a scan graph holds hits only
     ++input.sensor_messages;
   }
   const std::uint32_t num_edges = reader.u32("the edge count");
