@@ -71,6 +71,17 @@ struct CellVolumes {
   std::vector<Volume> negative;
 };
 
+/// A cell's two lists as the map stores them, without a copy: valid until the map next changes.
+/// Masses are in the unit of the cell's tile, which eq. (9) and every ratio of densities do not
+/// see (cellVolumes gives real masses).
+struct ColumnView {
+  const Volume* positive = nullptr;
+  std::uint32_t num_positive = 0;
+  const Volume* negative = nullptr;
+  std::uint32_t num_negative = 0;
+  bool empty() const { return num_positive + num_negative == 0; }
+};
+
 /// Memory held by the map.
 struct MemoryUsage {
   /// Bytes the map holds: its tiles, the index of tiles and every cell's volume storage with
@@ -142,6 +153,8 @@ class Map {
   PointOccupancy occupancy(const Eigen::Vector3d& point) const;
   /// The volume lists of one cell (empty lists for a cell never observed).
   CellVolumes cellVolumes(const CellIndex& cell) const;
+  /// The same without a copy, masses as stored (see ColumnView): for queries over many cells.
+  ColumnView column(const CellIndex& cell) const;
   /// Cell holding the world point (x, y).
   CellIndex cellAtPoint(double x, double y) const;
   /// Eq. (9) at height z (m) over `cells` (Fig. 5).

@@ -74,6 +74,13 @@ PointOccupancy Map::occupancy(const Eigen::Vector3d& point) const {
   return result;
 }
 
+ColumnView Map::column(const CellIndex& cell) const {
+  const detail::TileBlock* tile = findTile(detail::tileKeyOf(cell));
+  if (tile == nullptr) return {};
+  const detail::ColumnRef c = tile->column(detail::localIndex(cell));
+  return {c.positive, c.num_positive, c.negative, c.num_negative};
+}
+
 CellVolumes Map::cellVolumes(const CellIndex& cell) const {
   CellVolumes result;
   const detail::TileBlock* tile = findTile(detail::tileKeyOf(cell));

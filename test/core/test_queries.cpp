@@ -417,3 +417,31 @@ TEST(ForEachVolume, RegionRestrictsTheVisit) {
 
 }  // namespace
 }  // namespace mvog
+
+namespace mvog {
+namespace {
+
+TEST(Column, ViewsTheListsCellVolumesCopies) {
+  // The view holds the lists as stored: the same heights, masses in the tile's unit (after a
+  // decay step, a fixed multiple of the real masses), the same probabilities.
+  Map map = test::randomMap(3, 0.25, 6.0);
+  map.decay(0.5);
+  std::size_t cells = 0;
+  for (const CellIndex& cell : test::observedCells(map)) {
+    const ColumnView view = map.column(cell);
+    const CellVolumes copy = map.cellVolumes(cell);
+    ASSERT_EQ(view.num_positive, copy.positive.size());
+    ASSERT_EQ(view.num_negative, copy.negative.size());
+    for (std::uint32_t k = 0; k < view.num_negative; ++k) {
+      EXPECT_EQ(view.negative[k].bottom, copy.negative[k].bottom);
+      EXPECT_EQ(view.negative[k].top, copy.negative[k].top);
+      EXPECT_FLOAT_EQ(view.negative[k].mass * 0.5f, copy.negative[k].mass);
+    }
+    ++cells;
+  }
+  EXPECT_GT(cells, 100u);
+  EXPECT_TRUE(map.column({100000, 0}).empty());
+}
+
+}  // namespace
+}  // namespace mvog
