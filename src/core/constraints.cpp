@@ -66,7 +66,8 @@ void ListMerger::merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles,
   }
   for (Source& gap : gaps_) {
     double free_length = static_cast<double>(gap.top) - gap.bottom;
-    if (rules.no_gap_mass_over_obstacles) free_length -= coveredLength(gap.bottom, gap.top, obstacles);
+    if (rules.no_gap_mass_over_obstacles)
+      free_length -= coveredLength(gap.bottom, gap.top, obstacles);
     gap.mass = free_length * unit_mass;
   }
   for (const Component& component : components_) addPieces(component, out);
@@ -84,9 +85,9 @@ void ListMerger::sweep() {
   float sources_top = 0.0f;  // top of the sources of the current component so far
   bool has_source = false;
   while (next_source < sources_.size() || next_inside < inside_.size()) {
-    const bool take_inside =
-        next_inside < inside_.size() && (next_source == sources_.size() ||
-                                         inside_[next_inside].bottom < sources_[next_source].bottom);
+    const bool take_inside = next_inside < inside_.size() &&
+                             (next_source == sources_.size() ||
+                              inside_[next_inside].bottom < sources_[next_source].bottom);
     const float bottom = take_inside ? inside_[next_inside].bottom : sources_[next_source].bottom;
     const float top = take_inside ? inside_[next_inside].top : sources_[next_source].top;
     if (components_.empty() || !mustMerge(components_.back().top, bottom)) {
@@ -149,8 +150,7 @@ double ListMerger::massWithin(float bottom, float top) const {
         mass += s.mass;
         continue;
       }
-      const double overlap =
-          static_cast<double>(std::min(top, s.top)) - std::max(bottom, s.bottom);
+      const double overlap = static_cast<double>(std::min(top, s.top)) - std::max(bottom, s.bottom);
       if (overlap > 0.0) mass += s.mass * overlap / (static_cast<double>(s.top) - s.bottom);
     }
   }

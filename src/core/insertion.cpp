@@ -42,7 +42,8 @@ void addedVolumes(const std::vector<ScanInterval>& free, const std::vector<ScanI
   auto mass_of = [&](const ScanInterval& i, float bottom, float top) {
     return massOf(i, bottom, top, per_scan, unit_mass);
   };
-  for (const ScanInterval& i : hits) added.positive.push_back({i.bottom, i.top, mass_of(i, i.bottom, i.top)});
+  for (const ScanInterval& i : hits)
+    added.positive.push_back({i.bottom, i.top, mass_of(i, i.bottom, i.top)});
   for (const ScanInterval& i : free) {
     if (!rules.clip_free_space_at_hits) {
       added.negative.push_back({i.bottom, i.top, mass_of(i, i.bottom, i.top)});
@@ -52,7 +53,8 @@ void addedVolumes(const std::vector<ScanInterval>& free, const std::vector<ScanI
     // lower than kMinVolumeHeight (a sliver beside a hit) is dropped.
     float below = i.bottom;
     auto keep = [&](float bottom, float top) {
-      if (top - bottom >= kMinVolumeHeight) added.negative.push_back({bottom, top, mass_of(i, bottom, top)});
+      if (top - bottom >= kMinVolumeHeight)
+        added.negative.push_back({bottom, top, mass_of(i, bottom, top)});
     };
     for (const ScanInterval& hit : hits) {
       if (hit.top <= below) continue;
@@ -74,6 +76,7 @@ struct ColumnWork {
   std::vector<std::pair<const detail::ScanScratch*, const detail::ScratchTile*>> parts;
   std::vector<detail::TileHit> hits;                       // the tile's, by cell
   std::uint32_t hits_per_cell[detail::kCellsPerTile + 1];  // where each cell's start in hits
+  std::uint64_t reached[detail::kCellsPerTile / 64];       // the cells the scan reached
   std::vector<ScanInterval> free;
   std::vector<ScanInterval> positive;
   CellVolumes added;
@@ -99,20 +102,25 @@ namespace {
 void gatherTile(std::uint64_t key, const std::vector<detail::ScanScratch>& scratches,
                 ColumnWork& work) {
   work.parts.clear();
-  // The hits by cell (a counting sort), each cell's sorted by height.
-  std::fill(std::begin(work.hits_per_cell), std::end(work.hits_per_cell), 0u);
+  std::fill(std::begin(work.reached), std::end(work.reached), std::uint64_t{0});
   std::size_t num_hits = 0;
   for (const detail::ScanScratch& scratch : scratches) {
     if (const detail::ScratchTile* part = scratch.find(key)) {
       work.parts.emplace_back(&scratch, part);
-      for (const detail::TileHit& hit : part->hits) ++work.hits_per_cell[hit.local + 1];
       num_hits += part->hits.size();
+      for (std::size_t w = 0; w < std::size(work.reached); ++w) work.reached[w] |= part->reached[w];
     }
+  }
+  work.hits.resize(num_hits);
+  if (num_hits == 0) return;
+  // The hits by cell (a counting sort), each cell's sorted by height.
+  std::fill(std::begin(work.hits_per_cell), std::end(work.hits_per_cell), 0u);
+  for (const auto& part : work.parts) {
+    for (const detail::TileHit& hit : part.second->hits) ++work.hits_per_cell[hit.local + 1];
   }
   for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
     work.hits_per_cell[local + 1] += work.hits_per_cell[local];
   }
-  work.hits.resize(num_hits);
   std::uint32_t next[detail::kCellsPerTile];
   std::copy(work.hits_per_cell, work.hits_per_cell + detail::kCellsPerTile, next);
   for (const auto& part : work.parts) {
@@ -128,6 +136,12 @@ void gatherTile(std::uint64_t key, const std::vector<detail::ScanScratch>& scrat
   }
 }
 
+/// The number of hits the scan put into cell `local` (gatherTile's), and where they start.
+std::pair<std::uint32_t, std::uint32_t> hitsOf(unsigned local, const ColumnWork& work) {
+  if (work.hits.empty()) return {0, 0};
+  return {work.hits_per_cell[local], work.hits_per_cell[local + 1]};
+}
+
 /// What the scan saw in cell `local`: its free intervals and its hits, each joined.
 void scanColumn(unsigned local, float join_gap, ColumnWork& work) {
   work.free.clear();
@@ -141,7 +155,8 @@ void scanColumn(unsigned local, float join_gap, ColumnWork& work) {
     detail::joinSorted(work.free, join_gap);
   }
   work.positive.clear();
-  for (std::uint32_t h = work.hits_per_cell[local]; h < work.hits_per_cell[local + 1]; ++h) {
+  const auto [first_hit, end_hit] = hitsOf(local, work);
+  for (std::uint32_t h = first_hit; h < end_hit; ++h) {
     const detail::TileHit& hit = work.hits[h];
     const double mass = static_cast<double>(hit.top) - hit.bottom;  // density 1 (eq. 5)
     if (!work.positive.empty() && detail::joins(work.positive.back().top, hit.bottom, join_gap)) {
@@ -157,8 +172,7 @@ void scanColumn(unsigned local, float join_gap, ColumnWork& work) {
 /// holds free space, and no hit. The lists keep their volumes and bounds; each negative volume
 /// gains the mass that falls within it (what ListMerger gives: no gap closes, no obstacle is
 /// newly reached, so its pieces stay). Returns false, changing nothing, in any other case.
-bool addCoveredFreeSpace(const std::vector<Volume>& added, Volume* negative,
-                         std::uint32_t num_negative) {
+bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t num_negative) {
   if (num_negative == 0) return false;
   // Every added volume lies within one run of touching negative volumes.
   for (const Volume& a : added) {
@@ -202,63 +216,61 @@ void updateTile(detail::TileBlock& tile, std::uint64_t key,
                                         rules.clip_free_space_at_hits};
   const float join_gap = detail::joinGapOf(rules);
   const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
-  unsigned rank = 0;  // of the next cell holding volumes
-  for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
-    const bool held = tile.holds(local);
-    const unsigned cell_rank = rank;
-    rank += held ? 1 : 0;
-    const bool has_hits = work.hits_per_cell[local + 1] > work.hits_per_cell[local];
-    if (!has_hits && std::none_of(work.parts.begin(), work.parts.end(), [&](const auto& part) {
-          return part.first->reached(*part.second, local);
-        })) {
-      continue;
-    }
-    const detail::ColumnRef existing = held ? tile.columnAtRank(cell_rank) : detail::ColumnRef{};
-    // The tile's own storage of this cell, changed in place where the lengths stay.
-    Volume* stored = const_cast<Volume*>(existing.positive);
-    ScanInterval single;
-    if (!has_hits && held && work.parts.size() == 1 &&
-        work.parts[0].first->singleFree(*work.parts[0].second, local, single)) {
-      // The commonest case without a vector in between: one free interval, no hit.
-      work.added.negative.assign(
-          1, Volume{single.bottom, single.top,
-                    massOf(single, single.bottom, single.top, per_scan, unit_mass)});
-      if (addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
+  for (std::size_t word = 0; word < std::size(work.reached); ++word) {
+    for (std::uint64_t bits = work.reached[word]; bits != 0; bits &= bits - 1) {
+      const auto local = static_cast<unsigned>(64 * word + detail::lowestBit(bits));
+      const bool held = tile.holds(local);
+      const auto [first_hit, end_hit] = hitsOf(local, work);
+      const bool has_hits = end_hit > first_hit;
+      const detail::ColumnRef existing = held ? tile.column(local) : detail::ColumnRef{};
+      // The tile's own storage of this cell, changed in place where the lengths stay.
+      Volume* stored = const_cast<Volume*>(existing.positive);
+      ScanInterval single;
+      if (!has_hits && held && work.parts.size() == 1 &&
+          work.parts[0].first->singleFree(*work.parts[0].second, local, single)) {
+        // The commonest case without a vector in between: one free interval, no hit.
+        const Volume added{single.bottom, single.top,
+                           massOf(single, single.bottom, single.top, per_scan, unit_mass)};
+        if (addCoveredFreeSpace(VolumeRun(&added, 1), stored + existing.num_positive,
+                                existing.num_negative)) {
+          continue;
+        }
+      }
+      scanColumn(local, join_gap, work);
+      addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
+      if (work.added.positive.empty() &&
+          addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
                               existing.num_negative)) {
         continue;
       }
-    }
-    scanColumn(local, join_gap, work);
-    addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
-    if (work.added.positive.empty() &&
-        addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
-                            existing.num_negative)) {
-      continue;
-    }
-    work.existing_positive.assign(existing.positive, existing.positive + existing.num_positive);
-    work.existing_negative.assign(existing.negative, existing.negative + existing.num_negative);
-    if (work.added.positive.empty()) {
-      work.merged.positive = work.existing_positive;
-    } else {
-      work.merger.merge(work.existing_positive, work.added.positive, {}, {}, unit_mass,
-                        work.merged.positive);
-    }
-    work.merger.merge(work.existing_negative, work.added.negative, work.merged.positive,
-                      free_space_rules, unit_mass, work.merged.negative);
-    const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
-    const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());
-    if (held && num_positive == existing.num_positive && num_negative == existing.num_negative) {
-      // Mostly every list keeps its length (new volumes merge into those there).
-      std::copy(work.merged.positive.begin(), work.merged.positive.end(), stored);
-      std::copy(work.merged.negative.begin(), work.merged.negative.end(), stored + num_positive);
-      continue;
-    }
-    work.results.push_back({local, work.volumes.size(), num_positive, num_negative});
-    work.volumes.insert(work.volumes.end(), work.merged.positive.begin(), work.merged.positive.end());
-    work.volumes.insert(work.volumes.end(), work.merged.negative.begin(), work.merged.negative.end());
-    if (existing.empty() && num_positive + num_negative > 0) {
-      work.grown.extend(CellIndex{origin.x + static_cast<std::int32_t>(local % detail::kTileSize),
-                                  origin.y + static_cast<std::int32_t>(local / detail::kTileSize)});
+      work.existing_positive.assign(existing.positive, existing.positive + existing.num_positive);
+      work.existing_negative.assign(existing.negative, existing.negative + existing.num_negative);
+      if (work.added.positive.empty()) {
+        work.merged.positive = work.existing_positive;
+      } else {
+        work.merger.merge(work.existing_positive, work.added.positive, {}, {}, unit_mass,
+                          work.merged.positive);
+      }
+      work.merger.merge(work.existing_negative, work.added.negative, work.merged.positive,
+                        free_space_rules, unit_mass, work.merged.negative);
+      const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
+      const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());
+      if (held && num_positive == existing.num_positive && num_negative == existing.num_negative) {
+        // Mostly every list keeps its length (new volumes merge into those there).
+        std::copy(work.merged.positive.begin(), work.merged.positive.end(), stored);
+        std::copy(work.merged.negative.begin(), work.merged.negative.end(), stored + num_positive);
+        continue;
+      }
+      work.results.push_back({local, work.volumes.size(), num_positive, num_negative});
+      work.volumes.insert(work.volumes.end(), work.merged.positive.begin(),
+                          work.merged.positive.end());
+      work.volumes.insert(work.volumes.end(), work.merged.negative.begin(),
+                          work.merged.negative.end());
+      if (existing.empty() && num_positive + num_negative > 0) {
+        work.grown.extend(
+            CellIndex{origin.x + static_cast<std::int32_t>(local % detail::kTileSize),
+                      origin.y + static_cast<std::int32_t>(local / detail::kTileSize)});
+      }
     }
   }
   if (work.results.empty()) {
@@ -267,16 +279,15 @@ void updateTile(detail::TileBlock& tile, std::uint64_t key,
   }
   // Some list changed its length: the tile is built anew, its other cells copied.
   auto result = work.results.begin();
-  rank = 0;
+  unsigned rank = 0;  // of the next cell holding volumes
   for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
     const bool held = tile.holds(local);
     const detail::ColumnRef existing = held ? tile.columnAtRank(rank++) : detail::ColumnRef{};
     if (result != work.results.end() && result->local == local) {
       if (result->num_positive + result->num_negative > 0) {
         const Volume* v = work.volumes.data() + result->start;
-        work.builder.add(local, {v, result->num_positive, v + result->num_positive,
-                                 result->num_negative},
-                         1.0);
+        work.builder.add(
+            local, {v, result->num_positive, v + result->num_positive, result->num_negative}, 1.0);
       }
       ++result;
     } else if (held) {

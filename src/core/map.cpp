@@ -124,7 +124,8 @@ void Map::decay(double k_d) {
   // After some 2^24 binary orders of decay, move the exponents back near zero so that they stay
   // within 32 bits. No real mass changes that a double can show, and no stored mass changes.
   if (unit_exponent_ < kMinUnitExponent) {
-    for (auto& entry : storage_->tiles) entry.second.rebaseExponent(unit_exponent_, kMaxExponentLag);
+    for (auto& entry : storage_->tiles)
+      entry.second.rebaseExponent(unit_exponent_, kMaxExponentLag);
     unit_exponent_ = 0;
   }
 }
@@ -215,8 +216,9 @@ void Map::setCellVolumes(const std::vector<CellAssignment>& cells) {
       });
   if (changes_nothing) return;
   std::sort(by_tile.begin(), by_tile.end(), [](const auto& a, const auto& b) {
-    return a.first != b.first ? a.first < b.first
-                              : detail::localIndex(a.second->cell) < detail::localIndex(b.second->cell);
+    return a.first != b.first
+               ? a.first < b.first
+               : detail::localIndex(a.second->cell) < detail::localIndex(b.second->cell);
   });
 
   ++revision_;

@@ -66,8 +66,10 @@ PointOccupancy Map::occupancy(const Eigen::Vector3d& point) const {
   const auto z = static_cast<float>(point.z() * scale_inverse_);
   const Volume* positive = findVolume(column.positive, column.num_positive, z);
   const Volume* negative = findVolume(column.negative, column.num_negative, z);
-  if (positive != nullptr) result.positive_density = realMass(tile->exponent(), positive->density());
-  if (negative != nullptr) result.negative_density = realMass(tile->exponent(), negative->density());
+  if (positive != nullptr)
+    result.positive_density = realMass(tile->exponent(), positive->density());
+  if (negative != nullptr)
+    result.negative_density = realMass(tile->exponent(), negative->density());
   const float p = occupancyProbability(positive != nullptr ? positive->density() : 0.0f,
                                        negative != nullptr ? negative->density() : 0.0f);
   if (!std::isnan(p)) result.probability = p;
@@ -135,8 +137,9 @@ Grid2D<T> Map::fillGrid(const CellRange& cells, T unobserved, CellValue&& value_
 CrossSection Map::crossSection(double z, const CellRange& cells) const {
   if (!std::isfinite(z)) throw ConfigError("z: must be finite");
   const auto height = static_cast<float>(z * scale_inverse_);
-  return fillGrid<float>(cells, std::numeric_limits<float>::quiet_NaN(),
-                         [&](const detail::ColumnRef& column) { return probabilityAt(column, height); });
+  return fillGrid<float>(
+      cells, std::numeric_limits<float>::quiet_NaN(),
+      [&](const detail::ColumnRef& column) { return probabilityAt(column, height); });
 }
 
 Projection Map::projection(double z_min, double z_max, double occupancy_threshold,

@@ -2,9 +2,10 @@
 // to the core): ScanUpdate fills it, Map::apply reads it.
 #pragma once
 
-#include <cstddef>
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -55,6 +56,10 @@ struct ScratchTile {
   /// With MassCounting::kPerReading: the mass of each slot's inline interval.
   double masses[kCellsPerTile];
   std::vector<TileHit> hits;
+  /// Bit k: cell k got something in this scan (so that applying visits only those).
+  std::uint64_t reached[kCellsPerTile / 64];
+
+  void markReached(unsigned local) { reached[local >> 6] |= std::uint64_t{1} << (local & 63); }
 };
 
 /// Whether two intervals, one not below the other, join: the upper one's bottom is at most
@@ -84,8 +89,14 @@ class ScanScratch {
       ScratchTile& tile = tileFor(cell);
       const unsigned local = localIndex(cell);
       FreeSlot& slot = tile.slots[local];
-      if (slot.stamp == stamp_ &&
-          std::max(volume.bottom - slot.top, slot.bottom - volume.top) <= join_gap_ &&
+      if (slot.stamp != stamp_) {  // the cell's first interval of this scan
+        constexpr float kInfinity = std::numeric_limits<float>::infinity();
+        slot = {volume.bottom, volume.top, -kInfinity, kInfinity, stamp_, kNoOthers};
+        if (kCountMasses) tile.masses[local] = volume.mass;
+        tile.markReached(local);
+        return;
+      }
+      if (std::max(volume.bottom - slot.top, slot.bottom - volume.top) <= join_gap_ &&
           std::min(volume.bottom - slot.below, slot.above - volume.top) > join_gap_) {
         slot.bottom = std::min(slot.bottom, volume.bottom);
         slot.top = std::max(slot.top, volume.top);
@@ -95,8 +106,10 @@ class ScanScratch {
       scratch_.addFreeSlow(tile, local, volume);
     }
     void addHit(const CellIndex& cell, const Volume& volume) {
-      tileFor(cell).hits.push_back(
-          {static_cast<std::uint16_t>(localIndex(cell)), volume.bottom, volume.top});
+      ScratchTile& tile = tileFor(cell);
+      const unsigned local = localIndex(cell);
+      tile.hits.push_back({static_cast<std::uint16_t>(local), volume.bottom, volume.top});
+      tile.markReached(local);
     }
 
    private:
@@ -141,7 +154,7 @@ class ScanScratch {
 
  private:
   ScratchTile& findOrAddTile(std::int32_t tile_x, std::int32_t tile_y);
-  /// A slot's first interval of the scan, or one that does not only grow its inline interval.
+  /// An interval that does more than grow the inline interval of a slot of this scan.
   void addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume);
 
   /// The tiles reached, by key, and the index from tile to scratch: dense over the scan's tiles

@@ -87,6 +87,7 @@ ScratchTile& ScanScratch::findOrAddTile(std::int32_t tile_x, std::int32_t tile_y
     }
     *slot = pool_[reached_.size()].get();
     (*slot)->hits.clear();
+    std::fill(std::begin((*slot)->reached), std::end((*slot)->reached), std::uint64_t{0});
     reached_.emplace_back(tileKey(tile_x, tile_y), *slot);
   }
   return **slot;
@@ -96,11 +97,6 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
   FreeSlot& slot = tile.slots[local];
   const double mass = count_masses_ ? static_cast<double>(volume.mass) : 0.0;
-  if (slot.stamp != stamp_) {  // the cell's first interval of this scan
-    slot = {volume.bottom, volume.top, -kInfinity, kInfinity, stamp_, kNoOthers};
-    tile.masses[local] = mass;
-    return;
-  }
   if (slot.others == kNoOthers) {
     if (others_used_ == others_.size()) others_.emplace_back();
     slot.others = static_cast<std::uint32_t>(others_used_++);
@@ -210,8 +206,8 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
   walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
           [&](const CellIndex& cell, double z_enter, double z_exit, bool is_last) {
             if (!is_last || !obstacle) {  // eqs. (3) and (4)
-              scratch.addFree(cell, makeVolume(static_cast<float>(z_enter),
-                                               static_cast<float>(z_exit)));
+              scratch.addFree(cell,
+                              makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
               return;
             }
             const Volume positive = makeVolume(end_z - 0.5f, end_z + 0.5f);  // eq. (5)
@@ -258,7 +254,8 @@ void rasterizeReadings(const Scan& scan, std::size_t first, std::size_t last,
 
 detail::ThreadPool* ScanUpdate::Impl::threads(std::size_t count) {
   if (count <= 1) return nullptr;
-  if (pool == nullptr || pool->threads() != count) pool = std::make_unique<detail::ThreadPool>(count);
+  if (pool == nullptr || pool->threads() != count)
+    pool = std::make_unique<detail::ThreadPool>(count);
   return pool.get();
 }
 

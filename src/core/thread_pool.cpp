@@ -18,8 +18,7 @@ ThreadPool::~ThreadPool() {
   for (std::thread& worker : workers_) worker.join();
 }
 
-void ThreadPool::run(std::size_t count,
-                     const std::function<void(std::size_t, std::size_t)>& task) {
+void ThreadPool::run(std::size_t count, const std::function<void(std::size_t, std::size_t)>& task) {
   if (count == 0) return;
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -37,9 +37,9 @@ class ThreadPool {
   std::condition_variable done_;
   const std::function<void(std::size_t, std::size_t)>* task_ = nullptr;
   std::size_t count_ = 0;
-  std::size_t next_ = 0;       // the next task to hand out
-  std::size_t finished_ = 0;   // tasks returned
-  std::size_t batch_ = 0;      // increases with every run()
+  std::size_t next_ = 0;      // the next task to hand out
+  std::size_t finished_ = 0;  // tasks returned
+  std::size_t batch_ = 0;     // increases with every run()
   std::exception_ptr error_;
   bool stopping_ = false;
 };

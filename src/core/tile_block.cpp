@@ -30,70 +30,7 @@ std::size_t TileBlock::volumesOffset(std::uint32_t num_cells, bool wide) {
 
 std::size_t TileBlock::bytes() const {
   if (block_ == nullptr) return 0;
-  return volumesOffset(block_->num_cells, block_->wide != 0) +
-         std::size_t{block_->num_volumes} * sizeof(Volume);
-}
-
-namespace {
-
-/// Bits set in x, without a library call (the build targets no particular x86 level, where
-/// __builtin_popcountll calls libgcc).
-unsigned bitCount(std::uint64_t x) {
-  x = x - ((x >> 1) & 0x5555555555555555ull);
-  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
-  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
-  return static_cast<unsigned>((x * 0x0101010101010101ull) >> 56);
-}
-
-}  // namespace
-
-unsigned TileBlock::rank(unsigned local) const {
-  const unsigned word = local >> 6;
-  unsigned count = 0;
-  for (unsigned w = 0; w < word; ++w) count += bitCount(block_->occupied[w]);
-  const std::uint64_t below = (std::uint64_t{1} << (local & 63)) - 1;
-  return count + bitCount(block_->occupied[word] & below);
-}
-
-std::uint32_t TileBlock::start(unsigned rank) const {
-  const auto* base = reinterpret_cast<const unsigned char*>(block_ + 1);
-  if (block_->wide != 0) {
-    std::uint32_t value;
-    std::memcpy(&value, base + 4 * std::size_t{rank}, 4);
-    return value;
-  }
-  std::uint16_t value;
-  std::memcpy(&value, base + 2 * std::size_t{rank}, 2);
-  return value;
-}
-
-std::uint32_t TileBlock::positiveCount(unsigned rank) const {
-  const std::uint32_t n = block_->num_cells;
-  const auto* base = reinterpret_cast<const unsigned char*>(block_ + 1);
-  if (block_->wide != 0) {
-    std::uint32_t value;
-    std::memcpy(&value, base + 4 * (std::size_t{n} + 1 + rank), 4);
-    return value;
-  }
-  return base[2 * (std::size_t{n} + 1) + rank];
-}
-
-const Volume* TileBlock::volumes() const {
-  return reinterpret_cast<const Volume*>(reinterpret_cast<const unsigned char*>(block_) +
-                                         volumesOffset(block_->num_cells, block_->wide != 0));
-}
-
-ColumnRef TileBlock::column(unsigned local) const {
-  if (!holds(local)) return {};
-  return columnAtRank(rank(local));
-}
-
-ColumnRef TileBlock::columnAtRank(unsigned r) const {
-  const std::uint32_t first = start(r);
-  const std::uint32_t end = start(r + 1);
-  const std::uint32_t num_positive = positiveCount(r);
-  const Volume* list = volumes() + first;
-  return {list, num_positive, list + num_positive, end - first - num_positive};
+  return block_->volumes_offset + std::size_t{block_->num_volumes} * sizeof(Volume);
 }
 
 Volume* TileBlock::mutableVolumes(unsigned local) {
@@ -125,9 +62,8 @@ void TileBlock::Builder::add(unsigned local, const ColumnRef& column, double mas
   locals_.push_back(static_cast<std::uint16_t>(local));
   starts_.push_back(static_cast<std::uint32_t>(volumes_.size()));
   num_positive_.push_back(column.num_positive);
-  for (const auto& [list, count] :
-       {std::make_pair(column.positive, column.num_positive),
-        std::make_pair(column.negative, column.num_negative)}) {
+  for (const auto& [list, count] : {std::make_pair(column.positive, column.num_positive),
+                                    std::make_pair(column.negative, column.num_negative)}) {
     for (std::uint32_t k = 0; k < count; ++k) {
       Volume v = list[k];
       if (mass_scale != 1.0) v.mass = static_cast<float>(v.mass * mass_scale);
@@ -150,10 +86,9 @@ TileBlock TileBlock::Builder::finish(std::int32_t exponent, std::uint64_t modifi
   const auto num_cells = static_cast<std::uint32_t>(locals_.size());
   if (num_cells > 0) {
     const auto num_volumes = static_cast<std::uint32_t>(volumes_.size());
-    const bool wide =
-        num_volumes > std::numeric_limits<std::uint16_t>::max() ||
-        *std::max_element(num_positive_.begin(), num_positive_.end()) >
-            std::numeric_limits<std::uint8_t>::max();
+    const bool wide = num_volumes > std::numeric_limits<std::uint16_t>::max() ||
+                      *std::max_element(num_positive_.begin(), num_positive_.end()) >
+                          std::numeric_limits<std::uint8_t>::max();
     const std::size_t offset = volumesOffset(num_cells, wide);
     void* memory = std::malloc(offset + std::size_t{num_volumes} * sizeof(Volume));
     if (memory == nullptr) throw std::bad_alloc();
@@ -164,11 +99,17 @@ TileBlock TileBlock::Builder::finish(std::int32_t exponent, std::uint64_t modifi
     header.exponent = exponent;
     header.num_volumes = num_volumes;
     header.num_cells = static_cast<std::uint16_t>(num_cells);
+    header.volumes_offset = static_cast<std::uint16_t>(offset);
     header.wide = wide ? 1 : 0;
     auto* base = reinterpret_cast<unsigned char*>(tile.block_ + 1);
     starts_.push_back(num_volumes);
     for (std::uint32_t r = 0; r < num_cells; ++r) {
       header.occupied[locals_[r] >> 6] |= std::uint64_t{1} << (locals_[r] & 63);
+    }
+    unsigned before = 0;
+    for (unsigned w = 0; w + 1 < kCellsPerTile / 64; ++w) {
+      before += bitCount(header.occupied[w]);
+      header.words_before[w] = static_cast<std::uint8_t>(before);  // at most 192
     }
     for (std::uint32_t r = 0; r <= num_cells; ++r) {
       if (wide) {

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "mvog/cell_index.h"
@@ -20,6 +21,11 @@ constexpr int kCellsPerTile = kTileSize * kTileSize;
 inline unsigned localIndex(const CellIndex& c) {
   constexpr std::int32_t kMask = kTileSize - 1;
   return static_cast<unsigned>((c.y & kMask) * kTileSize + (c.x & kMask));
+}
+
+/// The index of the lowest set bit of bits != 0 (bsf: on every x86-64, unlike popcnt).
+inline unsigned lowestBit(std::uint64_t bits) {
+  return static_cast<unsigned>(__builtin_ctzll(bits));
 }
 
 /// A tile (x, y) as one hash key, and back: the only place tile keys are packed and unpacked.
@@ -79,7 +85,9 @@ class TileBlock {
   /// The map's mass exponent when the tile was written (see Map::decay).
   std::int32_t exponent() const { return block_ == nullptr ? 0 : block_->exponent; }
   /// The map revision at which a volume of the tile last changed.
-  std::uint64_t modifiedRevision() const { return block_ == nullptr ? 0 : block_->modified_revision; }
+  std::uint64_t modifiedRevision() const {
+    return block_ == nullptr ? 0 : block_->modified_revision;
+  }
   void setModifiedRevision(std::uint64_t revision) {
     if (block_ != nullptr) block_->modified_revision = revision;
   }
@@ -112,8 +120,13 @@ class TileBlock {
     std::int32_t exponent;
     std::uint32_t num_volumes;
     std::uint16_t num_cells;
-    std::uint8_t wide;  // 32-bit starts and positive counts
+    std::uint16_t volumes_offset;  // bytes from the block's start to its volumes
+    std::uint8_t wide;             // 32-bit starts and positive counts
+    /// Cells holding volumes in the bitmap's words before words 1, 2 and 3: a rank is then one
+    /// word's count.
+    std::uint8_t words_before[kCellsPerTile / 64 - 1];
   };
+  static_assert(sizeof(Header) == 56, "the header fills its 8-byte alignment exactly");
   /// Rank of cell `local` among the cells with volumes (its bit must be set).
   unsigned rank(unsigned local) const;
   std::uint32_t start(unsigned rank) const;
@@ -123,6 +136,65 @@ class TileBlock {
 
   Header* block_ = nullptr;
 };
+
+// The accessors of every query and insertion, inline.
+
+/// Bits set in x, without a library call (the build targets no particular x86 level, where
+/// __builtin_popcountll calls libgcc).
+inline unsigned bitCount(std::uint64_t x) {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<unsigned>((x * 0x0101010101010101ull) >> 56);
+}
+
+inline unsigned TileBlock::rank(unsigned local) const {
+  const unsigned word = local >> 6;
+  const std::uint64_t below = (std::uint64_t{1} << (local & 63)) - 1;
+  return (word == 0 ? 0u : block_->words_before[word - 1]) +
+         bitCount(block_->occupied[word] & below);
+}
+
+inline std::uint32_t TileBlock::start(unsigned rank) const {
+  const auto* base = reinterpret_cast<const unsigned char*>(block_ + 1);
+  if (block_->wide != 0) {
+    std::uint32_t value;
+    std::memcpy(&value, base + 4 * std::size_t{rank}, 4);
+    return value;
+  }
+  std::uint16_t value;
+  std::memcpy(&value, base + 2 * std::size_t{rank}, 2);
+  return value;
+}
+
+inline std::uint32_t TileBlock::positiveCount(unsigned rank) const {
+  const std::uint32_t n = block_->num_cells;
+  const auto* base = reinterpret_cast<const unsigned char*>(block_ + 1);
+  if (block_->wide != 0) {
+    std::uint32_t value;
+    std::memcpy(&value, base + 4 * (std::size_t{n} + 1 + rank), 4);
+    return value;
+  }
+  return base[2 * (std::size_t{n} + 1) + rank];
+}
+
+inline const Volume* TileBlock::volumes() const {
+  return reinterpret_cast<const Volume*>(reinterpret_cast<const unsigned char*>(block_) +
+                                         block_->volumes_offset);
+}
+
+inline ColumnRef TileBlock::column(unsigned local) const {
+  if (!holds(local)) return {};
+  return columnAtRank(rank(local));
+}
+
+inline ColumnRef TileBlock::columnAtRank(unsigned r) const {
+  const std::uint32_t first = start(r);
+  const std::uint32_t end = start(r + 1);
+  const std::uint32_t num_positive = positiveCount(r);
+  const Volume* list = volumes() + first;
+  return {list, num_positive, list + num_positive, end - first - num_positive};
+}
 
 }  // namespace detail
 }  // namespace mvog

@@ -46,8 +46,8 @@ std::string checkColumn(const Volume* positive, std::size_t num_positive, const 
                         std::size_t num_negative, bool split_free_space_at_obstacles) {
   std::string problem = checkList(positive, num_positive, nullptr, 0, false);
   if (!problem.empty()) return "positive " + problem;
-  problem = checkList(negative, num_negative, positive, num_positive,
-                      split_free_space_at_obstacles);
+  problem =
+      checkList(negative, num_negative, positive, num_positive, split_free_space_at_obstacles);
   if (!problem.empty()) return "negative " + problem;
   return {};
 }

@@ -31,7 +31,8 @@ class ReferenceModel {
   void insertScan(const Scan& scan, const InsertionConfig& insertion = {}) {
     const double s = 1.0 / config_.resolution;
     const Eigen::Vector3d start = scan.origin * s;
-    std::map<std::pair<std::int32_t, std::int32_t>, std::pair<std::vector<Volume>, std::vector<Volume>>>
+    std::map<std::pair<std::int32_t, std::int32_t>,
+             std::pair<std::vector<Volume>, std::vector<Volume>>>
         seen;  // per cell: the scan's free volumes, its hits' volumes
     auto reading = [&](const Eigen::Vector3f& point, bool is_obstacle) {
       const Eigen::Vector3d ray = point.cast<double>() - scan.origin;
@@ -47,20 +48,21 @@ class ReferenceModel {
                                 : point.cast<double>()) *
           s;
       const auto end_z = static_cast<float>(end.z());
-      walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
-              [&](const CellIndex& c, double z_enter, double z_exit, bool is_last) {
-                auto& [free, hits] = seen[{c.x, c.y}];
-                if (!is_last || !obstacle) {
-                  free.push_back(makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
-                  return;
-                }
-                const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
-                hits.push_back(hit);
-                if (std::fabs(z_enter - end.z()) > 1.0) {
-                  free.push_back(makeVolume(static_cast<float>(z_enter),
-                                            z_enter < end.z() ? hit.bottom : hit.top));
-                }
-              });
+      walkRay(
+          start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
+          [&](const CellIndex& c, double z_enter, double z_exit, bool is_last) {
+            auto& [free, hits] = seen[{c.x, c.y}];
+            if (!is_last || !obstacle) {
+              free.push_back(makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
+              return;
+            }
+            const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
+            hits.push_back(hit);
+            if (std::fabs(z_enter - end.z()) > 1.0) {
+              free.push_back(makeVolume(static_cast<float>(z_enter),
+                                        z_enter < end.z() ? hit.bottom : hit.top));
+            }
+          });
     };
     for (const Eigen::Vector3f& hit : scan.hits) reading(hit, true);
     for (const Eigen::Vector3f& end : scan.out_of_range) reading(end, false);
@@ -93,11 +95,11 @@ class ReferenceModel {
         }
         for (const auto& [b, t] : parts) {
           if (t - b < kMinVolumeHeight) continue;
-          const double mass = per_scan ? static_cast<double>(t) - b
-                                       : (b == f.bottom && t == f.top)
-                                             ? f.mass
-                                             : f.mass * (static_cast<double>(t) - b) /
-                                                   (static_cast<double>(f.top) - f.bottom);
+          const double mass =
+              per_scan ? static_cast<double>(t) - b
+              : (b == f.bottom && t == f.top)
+                  ? f.mass
+                  : f.mass * (static_cast<double>(t) - b) / (static_cast<double>(f.top) - f.bottom);
           added_free.push_back({b, t, static_cast<float>(mass)});
         }
       }
@@ -163,23 +165,25 @@ inline ::testing::AssertionResult sameAsReference(const Map& map, const Referenc
         std::ostringstream text;
         text << "cell (" << key.first << ", " << key.second << ") "
              << (positive ? "positive" : "negative") << ": map";
-        for (const Volume& v : a) text << " [" << v.bottom << ", " << v.top << " | " << v.mass << "]";
+        for (const Volume& v : a)
+          text << " [" << v.bottom << ", " << v.top << " | " << v.mass << "]";
         text << ", reference";
-        for (const Volume& v : b) text << " [" << v.bottom << ", " << v.top << " | " << v.mass << "]";
+        for (const Volume& v : b)
+          text << " [" << v.bottom << ", " << v.top << " | " << v.mass << "]";
         return ::testing::AssertionFailure() << text.str();
       }
     }
   }
   std::size_t map_cells = 0;
   map.forEachVolume([&, last = CellIndex{0, 0}, first = true](const CellIndex& c, VolumeSign,
-                                                               const Volume&) mutable {
+                                                              const Volume&) mutable {
     if (first || c != last) ++map_cells;
     first = false;
     last = c;
   });
   if (map_cells != cells) {
-    return ::testing::AssertionFailure() << "the map has " << map_cells
-                                         << " cells with volumes, the reference " << cells;
+    return ::testing::AssertionFailure()
+           << "the map has " << map_cells << " cells with volumes, the reference " << cells;
   }
   return ::testing::AssertionSuccess();
 }

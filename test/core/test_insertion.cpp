@@ -609,7 +609,8 @@ TEST(Insertion, EveryRuleSetEqualsThePlainReference) {
   }
 }
 
-// ---- The model's rules ---------------------------------------------------------------------------
+// ---- The model's rules
+// ---------------------------------------------------------------------------
 
 /// A scan along +x at height 0.5 in cells of 1 m: A hits cell (5, 0), B passes through it at
 /// A's height on its way to cell (8, 0), C passes above it.
@@ -695,7 +696,8 @@ TEST(Rules, PerScanAHeightCountsOncePerScan) {
   // 100 rays of one scan through cell (2, 0) at the same height, ending in cell (5, 0).
   Scan scan;
   scan.origin = {0.5, 0.5, 0.5};
-  for (int k = 0; k < 100; ++k) scan.hits.push_back({5.5f, 0.5f + 0.001f * static_cast<float>(k), 0.5f});
+  for (int k = 0; k < 100; ++k)
+    scan.hits.push_back({5.5f, 0.5f + 0.001f * static_cast<float>(k), 0.5f});
   for (const MassCounting counting : {MassCounting::kPerScan, MassCounting::kPerReading}) {
     ModelRules rules = ModelRules::paper();
     rules.mass_counting = counting;
@@ -731,8 +733,8 @@ TEST(Rules, PerScanTheScansFreeHeightsJoinAcrossGapsOfOne) {
     map.insertScan(later);
     const CellVolumes cell = map.cellVolumes({2, 0});
     ASSERT_EQ(cell.negative.size(), 1u);
-    EXPECT_TRUE(volumeIs(cell.negative[0], -0.5, 2.5,
-                         counting == MassCounting::kPerScan ? 4.0 : 3.0));
+    EXPECT_TRUE(
+        volumeIs(cell.negative[0], -0.5, 2.5, counting == MassCounting::kPerScan ? 4.0 : 3.0));
   }
 }
 

@@ -124,7 +124,7 @@ TEST(Decay, LongDecayedReadingsGiveWayToNewOnes) {
   // masses in the tile written, decayed below float range against the new ones, become 0.
   Map map(unitConfig());
   map.insertReading({0.5, 0.5, 0}, {0.5, 0.5, 5}, ReadingKind::kObstacle);
-  map.insertReading({3.5, 0.5, 0}, {3.5, 0.5, 5}, ReadingKind::kObstacle);  // same tile
+  map.insertReading({3.5, 0.5, 0}, {3.5, 0.5, 5}, ReadingKind::kObstacle);    // same tile
   map.insertReading({40.5, 0.5, 0}, {40.5, 0.5, 5}, ReadingKind::kObstacle);  // untouched below
   const PointOccupancy untouched = map.occupancy({40.5, 0.5, 5.0});
   for (int step = 0; step < 500; ++step) map.decay(0.5);

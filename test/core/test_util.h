@@ -99,7 +99,7 @@ inline std::vector<CellIndex> observedCells(const Map& map) {
 /// touch where one of `boundaries` begins or ends (ModelRules::split_free_space_at_obstacles:
 /// negative volumes cut at the positive ones).
 inline ::testing::AssertionResult satisfiesConstraints(const std::vector<Volume>& list,
-                                                      const std::vector<Volume>& boundaries = {}) {
+                                                       const std::vector<Volume>& boundaries = {}) {
   for (std::size_t k = 0; k < list.size(); ++k) {
     const Volume& v = list[k];
     std::ostringstream where;
@@ -114,9 +114,8 @@ inline ::testing::AssertionResult satisfiesConstraints(const std::vector<Volume>
       const Volume& below = list[k - 1];
       const bool at_a_boundary =
           below.top == v.bottom &&
-          std::any_of(boundaries.begin(), boundaries.end(), [&](const Volume& b) {
-            return b.bottom == v.bottom || b.top == v.bottom;
-          });
+          std::any_of(boundaries.begin(), boundaries.end(),
+                      [&](const Volume& b) { return b.bottom == v.bottom || b.top == v.bottom; });
       if (at_a_boundary) continue;
       if (!(below.bottom < v.bottom) || !(below.top < v.bottom)) {
         return ::testing::AssertionFailure() << where.str() << "unsorted or overlapping";

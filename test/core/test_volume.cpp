@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <initializer_list>
 #include <limits>
 #include <random>
@@ -316,14 +316,16 @@ TEST(ListMerger, OverlapsMergeBeforeGapsClose) {
   // Eq. (7) before eq. (8), over all the scan's volumes and those already there: [1, 1.5] covers
   // the gap between [0, 1] and [1.5, 2.5], so no gap mass is added. Inserted one after the other
   // ([1.5, 2.5] first), the gap would have been filled at density 1 before [1, 1.5] arrived.
-  const std::vector<Volume> list = merged({fresh(0.0f, 1.0f)}, {fresh(1.5f, 2.5f), fresh(1.0f, 1.5f)});
+  const std::vector<Volume> list =
+      merged({fresh(0.0f, 1.0f)}, {fresh(1.5f, 2.5f), fresh(1.0f, 1.5f)});
   ASSERT_EQ(list.size(), 1u);
   EXPECT_TRUE(volumeIs(list[0], 0.0, 2.5, 2.5));
 }
 
 TEST(ListMerger, ScanVolumesCloseTheirGapsToo) {
   // [0, 1], [1.5, 2.5], [3, 4] arrive together: gaps of 0.5 are closed at density 1.
-  const std::vector<Volume> list = merged({}, {fresh(3.0f, 4.0f), fresh(0.0f, 1.0f), fresh(1.5f, 2.5f)});
+  const std::vector<Volume> list =
+      merged({}, {fresh(3.0f, 4.0f), fresh(0.0f, 1.0f), fresh(1.5f, 2.5f)});
   ASSERT_EQ(list.size(), 1u);
   EXPECT_TRUE(volumeIs(list[0], 0.0, 4.0, 4.0));
 }
@@ -359,7 +361,8 @@ TEST(ListMerger, TheResultDependsOnTheSetOfVolumesNotTheirOrder) {
 // ---- Sec. V.C: free space split at obstacles (ModelRules::split_free_space_at_obstacles) ------
 
 /// `negative` with `added` merged in next to the obstacles `positive`, with the model's rules.
-std::vector<Volume> mergedFree(const std::vector<Volume>& negative, const std::vector<Volume>& added,
+std::vector<Volume> mergedFree(const std::vector<Volume>& negative,
+                               const std::vector<Volume>& added,
                                const std::vector<Volume>& positive, bool split,
                                bool no_gap_mass_over_obstacles = false) {
   ListMerger merger;
@@ -372,13 +375,15 @@ std::vector<Volume> mergedFree(const std::vector<Volume>& negative, const std::v
 TEST(ListMerger, FreeSpaceIsCutAtTheObstacleItReaches) {
   // Free space [0, 10] at density 1 through an obstacle [4, 6]: three pieces, the middle one
   // holding exactly the obstacle's heights and the mass that fell within them (2 of 10).
-  const std::vector<Volume> pieces = mergedFree({}, {fresh(0.0f, 10.0f)}, {fresh(4.0f, 6.0f)}, true);
+  const std::vector<Volume> pieces =
+      mergedFree({}, {fresh(0.0f, 10.0f)}, {fresh(4.0f, 6.0f)}, true);
   ASSERT_EQ(pieces.size(), 3u);
   EXPECT_TRUE(volumeIs(pieces[0], 0.0, 4.0, 4.0));
   EXPECT_TRUE(volumeIs(pieces[1], 4.0, 6.0, 2.0));
   EXPECT_TRUE(volumeIs(pieces[2], 6.0, 10.0, 4.0));
   // The paper's rule averages it over the whole volume.
-  const std::vector<Volume> paper = mergedFree({}, {fresh(0.0f, 10.0f)}, {fresh(4.0f, 6.0f)}, false);
+  const std::vector<Volume> paper =
+      mergedFree({}, {fresh(0.0f, 10.0f)}, {fresh(4.0f, 6.0f)}, false);
   ASSERT_EQ(paper.size(), 1u);
   EXPECT_TRUE(volumeIs(paper[0], 0.0, 10.0, 10.0));
 }
@@ -406,7 +411,8 @@ TEST(ListMerger, AShortPieceBesideAnObstacleJoinsIt) {
 TEST(ListMerger, PiecesFollowAnObstacleThatGrows) {
   // Pieces cut at [4, 6] become pieces cut at [3, 6] when the obstacle grows downwards: the
   // piece below gives the part it loses to the obstacle's piece, in proportion (density kept).
-  const std::vector<Volume> before = mergedFree({}, {fresh(0.0f, 10.0f)}, {fresh(4.0f, 6.0f)}, true);
+  const std::vector<Volume> before =
+      mergedFree({}, {fresh(0.0f, 10.0f)}, {fresh(4.0f, 6.0f)}, true);
   const std::vector<Volume> after = mergedFree(before, {}, {fresh(3.0f, 6.0f)}, true);
   ASSERT_EQ(after.size(), 3u);
   EXPECT_TRUE(volumeIs(after[0], 0.0, 3.0, 3.0));

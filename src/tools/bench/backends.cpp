@@ -172,7 +172,9 @@ std::unordered_set<std::uint64_t> voxelsCrossed(const InputData& input, double m
 WalkStats runWalk(const InputData& input, const RunOptions& options) {
   const double s = 1.0 / options.resolution;
   mvog::CellRange cells = mvog::kNoCells;
-  auto include = [&](const Eigen::Vector3d& p) { cells.extend(mvog::cellAt(p.x() * s, p.y() * s)); };
+  auto include = [&](const Eigen::Vector3d& p) {
+    cells.extend(mvog::cellAt(p.x() * s, p.y() * s));
+  };
   std::vector<std::vector<Eigen::Vector3d>> ends(input.scans.size());
   for (std::size_t k = 0; k < input.scans.size(); ++k) {
     include(input.scans[k].origin);
@@ -215,8 +217,7 @@ WalkStats runWalk(const InputData& input, const RunOptions& options) {
   return stats;
 }
 
-SamplePoints samplePoints(const InputData& input, const RunOptions& options,
-                          std::size_t max_rays) {
+SamplePoints samplePoints(const InputData& input, const RunOptions& options, std::size_t max_rays) {
   constexpr double kFractions[] = {0.1, 0.3, 0.5, 0.7, 0.9};
   const std::size_t stride = std::max<std::size_t>(1, (input.readings() + max_rays - 1) / max_rays);
   SamplePoints points;
@@ -306,8 +307,8 @@ std::size_t StateAgreement::points() const {
 
 std::size_t StateAgreement::agreeing() const { return counts[0][0] + counts[1][1] + counts[2][2]; }
 
-Agreement compareMaps(const SamplePoints& points, const mvog::Map& map,
-                      double occupancy_threshold, const octomap::OcTree& tree) {
+Agreement compareMaps(const SamplePoints& points, const mvog::Map& map, double occupancy_threshold,
+                      const octomap::OcTree& tree) {
   Agreement agreement;
   agreement.sampled_rays = points.sampled_rays;
   auto compare = [&](const std::vector<Eigen::Vector3d>& at, StateAgreement& into) {

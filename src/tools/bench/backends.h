@@ -89,8 +89,7 @@ struct SamplePoints {
   /// was seen there.
   std::vector<Eigen::Vector3d> far_from_data;
 };
-SamplePoints samplePoints(const InputData& input, const RunOptions& options,
-                          std::size_t max_rays);
+SamplePoints samplePoints(const InputData& input, const RunOptions& options, std::size_t max_rays);
 
 /// How many of some points a map calls unknown, free and occupied (index: mvog::OccupancyState).
 struct StateCounts {
@@ -100,8 +99,8 @@ struct StateCounts {
   double percent(mvog::OccupancyState state) const;
 };
 
-/// What a map says at the sample points (MVOG: occupancy().state(threshold); OctoMap: search(), null
-/// = unknown, else isNodeOccupied()).
+/// What a map says at the sample points (MVOG: occupancy().state(threshold); OctoMap: search(),
+/// null = unknown, else isNodeOccupied()).
 struct Quality {
   StateCounts endpoints;      ///< an obstacle was certainly there: occupied is right
   StateCounts along_rays;     ///< the ray passed: free is right
@@ -124,7 +123,7 @@ struct Agreement {
   StateAgreement along_rays;
 };
 
-Agreement compareMaps(const SamplePoints& points, const mvog::Map& map,
-                      double occupancy_threshold, const octomap::OcTree& tree);
+Agreement compareMaps(const SamplePoints& points, const mvog::Map& map, double occupancy_threshold,
+                      const octomap::OcTree& tree);
 
 }  // namespace mvog_bench

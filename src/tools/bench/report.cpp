@@ -199,7 +199,8 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
   } else {
     std::fprintf(out, "max range   none\n");
   }
-  std::fprintf(out, "MVOG rules  %s%s; occupied where p > %.3f\n\n", rulesText(report.rules).c_str(),
+  std::fprintf(out, "MVOG rules  %s%s; occupied where p > %.3f\n\n",
+               rulesText(report.rules).c_str(),
                report.rules == mvog::ModelRules::paper() ? " (the paper's model)" : "",
                report.occupancy_threshold);
 
@@ -219,9 +220,9 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                    r.octomap->binary_file_bytes, r.octomap->full_file_bytes);
     }
     if (r.walk) {
-      std::fprintf(out, "%-8s %7.3f %7d %10zu %10.3f %12.0f %14s %14s %14s\n", "walk",
-                   r.resolution, 1, readings, r.walk->insert_seconds,
-                   perSecond(readings, r.walk->insert_seconds), "-", "-", "-");
+      std::fprintf(out, "%-8s %7.3f %7d %10zu %10.3f %12.0f %14s %14s %14s\n", "walk", r.resolution,
+                   1, readings, r.walk->insert_seconds, perSecond(readings, r.walk->insert_seconds),
+                   "-", "-", "-");
     }
   }
 
@@ -240,8 +241,8 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
         quality_header = true;
       }
       const Quality& q = **quality;
-      std::fprintf(out, "%-8s %7.3f %11.1f%% %11.1f%% %11.1f%% %10zu %10zu\n", name,
-                   r.resolution, q.endpoints.percent(mvog::OccupancyState::kOccupied),
+      std::fprintf(out, "%-8s %7.3f %11.1f%% %11.1f%% %11.1f%% %10zu %10zu\n", name, r.resolution,
+                   q.endpoints.percent(mvog::OccupancyState::kOccupied),
                    q.along_rays.percent(mvog::OccupancyState::kFree),
                    q.far_from_data.percent(mvog::OccupancyState::kUnknown), q.endpoints.points(),
                    q.far_from_data.points());
@@ -308,7 +309,8 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
           .add("insert_seconds", r.walk->insert_seconds)
           .add("readings_per_second", perSecond(readings, r.walk->insert_seconds))
           .add("cell_visits", r.walk->cell_visits);
-      if (r.mvog) walk.add("mvog_time_ratio", ratio(r.mvog->insert_seconds, r.walk->insert_seconds));
+      if (r.mvog)
+        walk.add("mvog_time_ratio", ratio(r.mvog->insert_seconds, r.walk->insert_seconds));
       results.push_back(walk);
     }
     for (const auto& [name, q] :
