@@ -1,4 +1,4 @@
-#include "conversions.h"
+#include "mvog_ros/conversions.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "mapper.h"
+#include "mvog_ros/mapper.h"
 
 #include <algorithm>
 #include <chrono>
@@ -6,11 +6,11 @@
 
 #include <tf2_eigen/tf2_eigen.h>
 
-#include "conversions.h"
-#include "map_paths.h"
 #include "mvog/MapBinary.h"
 #include "mvog/MapStatistics.h"
 #include "mvog/map_io.h"
+#include "mvog_ros/conversions.h"
+#include "mvog_ros/map_paths.h"
 
 namespace mvog_ros {
 namespace {

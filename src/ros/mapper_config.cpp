@@ -1,4 +1,4 @@
-#include "mapper_config.h"
+#include "mvog_ros/mapper_config.h"
 
 #include <cmath>
 #include <cstdint>

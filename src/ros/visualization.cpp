@@ -1,4 +1,4 @@
-#include "visualization.h"
+#include "mvog_ros/visualization.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// libFuzzer target: the message conversions of the ROS layer (src/ros/conversions.h) on
+// libFuzzer target: the message conversions of the ROS layer (mvog_ros/conversions.h) on
 // LaserScan and PointCloud2 messages built from arbitrary bytes, then insertion of what they
 // yield into a map.
 //
@@ -28,7 +28,7 @@
 #include <string>
 #include <vector>
 
-#include "../../src/ros/conversions.h"
+#include "mvog_ros/conversions.h"
 
 namespace {
 

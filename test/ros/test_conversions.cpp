@@ -1,4 +1,4 @@
-// LaserScan and PointCloud2 to readings (src/ros/conversions.h): REP-117 semantics, every cloud
+// LaserScan and PointCloud2 to readings (mvog_ros/conversions.h): REP-117 semantics, every cloud
 // layout, the sensor pose, and the refusal of every malformed message.
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "../../src/ros/conversions.h"
+#include "mvog_ros/conversions.h"
 
 namespace mvog_ros {
 namespace {

@@ -1,4 +1,4 @@
-// MapperConfig::validate (src/ros/mapper_config.h): every invalid parameter is refused with a
+// MapperConfig::validate (mvog_ros/mapper_config.h): every invalid parameter is refused with a
 // message naming it. (fromParameters needs a master: the rostests cover it.)
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "../../src/ros/mapper_config.h"
+#include "mvog_ros/mapper_config.h"
 
 namespace mvog_ros {
 namespace {

@@ -13,8 +13,8 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "conversions.h"
 #include "input.h"
+#include "mvog_ros/conversions.h"
 
 namespace mvog_bench {
 namespace {

@@ -20,14 +20,14 @@
 #include <tf2_ros/transform_listener.h>
 #include <Eigen/Geometry>
 
-#include "mapper_config.h"
 #include "mvog/GetCrossSection.h"
 #include "mvog/GetOccupancy.h"
 #include "mvog/MapBinary.h"
 #include "mvog/MapFile.h"
 #include "mvog/map.h"
-#include "visualization.h"
-#include "writer_preferring_mutex.h"
+#include "mvog_ros/mapper_config.h"
+#include "mvog_ros/visualization.h"
+#include "mvog_ros/writer_preferring_mutex.h"
 
 namespace mvog_ros {
 
