@@ -229,8 +229,8 @@ void Mapper::insertScan(const sensor_msgs::LaserScan& scan,
   try {
     std::size_t skipped = 0;
     PendingScan pending{
-        scanToReadings(scan, map_from_sensor, config_.insertion.max_range,
-                       static_cast<std::size_t>(config_.max_points_per_message), skipped),
+        laserScanToScan(scan, map_from_sensor, config_.insertion.max_range,
+                        static_cast<std::size_t>(config_.max_points_per_message), skipped),
         "LaserScan"};
     counters_.readings_rejected += skipped;
     enqueue(std::move(pending));
@@ -242,8 +242,8 @@ void Mapper::insertScan(const sensor_msgs::LaserScan& scan,
 void Mapper::insertCloud(const sensor_msgs::PointCloud2& cloud,
                          const Eigen::Isometry3d& map_from_sensor) {
   try {
-    PendingScan pending{cloudToReadings(cloud, map_from_sensor,
-                                        static_cast<std::size_t>(config_.max_points_per_message)),
+    PendingScan pending{pointCloudToScan(cloud, map_from_sensor,
+                                         static_cast<std::size_t>(config_.max_points_per_message)),
                         "PointCloud2"};
     if (config_.voxel_filter_size > 0.0) {
       counters_.readings_rejected += voxelFilter(pending.scan.hits, config_.voxel_filter_size);
