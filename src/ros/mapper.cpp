@@ -25,14 +25,15 @@ constexpr std::size_t kReadingsPerLock = 16384;
 /// else an empty one. Throws mvog::ConfigError naming the parameter at fault.
 mvog::Map initialMap(const MapperConfig& config) {
   try {
-    makeDirectories(config.map_directory);
+    makeDirectories(config.map_files.map_directory);
   } catch (const PathRefused& e) {
     throw mvog::ConfigError("~map_directory: " + std::string(e.what()));
   }
-  if (config.map_file.empty()) return mvog::Map(config.map);
+  if (config.map_files.map_file.empty()) return mvog::Map(config.map);
   try {
-    mvog::Map map = mvog::loadMap(resolveMapPath(config.map_directory, config.map_file, false));
-    ROS_INFO("mvog: loaded ~map_file '%s' (resolution %.3f m)", config.map_file.c_str(),
+    mvog::Map map = mvog::loadMap(
+        resolveMapPath(config.map_files.map_directory, config.map_files.map_file, false));
+    ROS_INFO("mvog: loaded ~map_file '%s' (resolution %.3f m)", config.map_files.map_file.c_str(),
              map.resolution());
     return map;
   } catch (const std::exception& e) {  // PathRefused or mvog::MapFileError
@@ -69,17 +70,17 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
   occupied_publisher_ = marker_publisher("occupied", true);
 
   const std::int64_t max_grid_cells = config_.max_cross_section_cells;
-  grids_.emplace_back(
-      config_.projection_min_z, max_grid_cells,
-      [this](const mvog::Map& map, const mvog::CellRange& cells) {
-        return toOccupancyGrid(map.projection(config_.projection_min_z, config_.projection_max_z,
-                                              config_.occupancy_threshold, cells),
-                               0.0, "", ros::Time())
-            .data;
-      });
+  grids_.emplace_back(config_.publications.projection_min_z, max_grid_cells,
+                      [this](const mvog::Map& map, const mvog::CellRange& cells) {
+                        return toOccupancyGrid(map.projection(config_.publications.projection_min_z,
+                                                              config_.publications.projection_max_z,
+                                                              config_.occupancy_threshold, cells),
+                                               0.0, "", ros::Time())
+                            .data;
+                      });
   std::vector<std::string> grid_topics{"projected_map"};
-  for (std::size_t k = 0; k < config_.cross_section_heights.size(); ++k) {
-    const double height = config_.cross_section_heights[k];
+  for (std::size_t k = 0; k < config_.publications.cross_section_heights.size(); ++k) {
+    const double height = config_.publications.cross_section_heights[k];
     grids_.emplace_back(
         height, max_grid_cells, [height](const mvog::Map& map, const mvog::CellRange& cells) {
           return toOccupancyGrid(map.crossSection(height, cells), height, "", ros::Time()).data;
@@ -106,19 +107,20 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
   services_.push_back(private_nh_.advertiseService("load_map", &Mapper::loadMap, this));
   services_.push_back(private_nh_.advertiseService("reset", &Mapper::reset, this));
 
-  timers_.push_back(
-      nh_.createTimer(ros::Duration(config_.publish_period), &Mapper::publishChanges, this));
-  timers_.push_back(
-      nh_.createTimer(ros::Duration(config_.statistics_period), &Mapper::publishStatistics, this));
-  if (config_.binary_map_period > 0.0) {
+  timers_.push_back(nh_.createTimer(ros::Duration(config_.publications.publish_period),
+                                    &Mapper::publishChanges, this));
+  timers_.push_back(nh_.createTimer(ros::Duration(config_.publications.statistics_period),
+                                    &Mapper::publishStatistics, this));
+  if (config_.publications.binary_map_period > 0.0) {
+    timers_.push_back(nh_.createTimer(ros::Duration(config_.publications.binary_map_period),
+                                      &Mapper::publishBinaryMap, this));
+  }
+  if (config_.decay.enabled()) {
     timers_.push_back(
-        nh_.createTimer(ros::Duration(config_.binary_map_period), &Mapper::publishBinaryMap, this));
+        nh_.createTimer(ros::Duration(config_.decay.decay_period), &Mapper::decay, this));
   }
-  if (config_.decay_period > 0.0 && config_.decay_factor < 1.0) {
-    timers_.push_back(nh_.createTimer(ros::Duration(config_.decay_period), &Mapper::decay, this));
-  }
-  if (config_.autosave_period > 0.0) {
-    timers_.push_back(nh_.createTimer(ros::Duration(config_.autosave_period),
+  if (config_.map_files.autosave_period > 0.0) {
+    timers_.push_back(nh_.createTimer(ros::Duration(config_.map_files.autosave_period),
                                       [this](const ros::TimerEvent&) { autosave(); }));
   }
   last_statistics_time_ = ros::WallTime::now();
@@ -126,16 +128,17 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   // Inputs last, once everything they feed exists.
   subscribe<sensor_msgs::LaserScan>("scan");
-  for (const std::string& topic : config_.scan_topics) subscribe<sensor_msgs::LaserScan>(topic);
+  for (const std::string& topic : config_.inputs.scan_topics)
+    subscribe<sensor_msgs::LaserScan>(topic);
   subscribe<sensor_msgs::PointCloud2>("cloud_in");
-  for (const std::string& topic : config_.cloud_topics) {
+  for (const std::string& topic : config_.inputs.cloud_topics) {
     subscribe<sensor_msgs::PointCloud2>(topic);
   }
   timers_.push_back(
       nh_.createTimer(ros::Duration(kTransformRetryPeriod), &Mapper::retryWaitingMessages, this));
   ROS_INFO("mvog: mapping in '%s' at %.3f m, %zu scan and %zu cloud topics",
-           config_.frame_id.c_str(), map_.resolution(), config_.scan_topics.size() + 1,
-           config_.cloud_topics.size() + 1);
+           config_.frame_id.c_str(), map_.resolution(), config_.inputs.scan_topics.size() + 1,
+           config_.inputs.cloud_topics.size() + 1);
 }
 
 Mapper::~Mapper() {
@@ -148,7 +151,7 @@ Mapper::~Mapper() {
   queue_changed_.notify_all();
   insertion_thread_.join();
   // A clean shutdown loses nothing mapped since the last autosave.
-  if (config_.autosave_period > 0.0) autosave();
+  if (config_.map_files.autosave_period > 0.0) autosave();
 }
 
 template <class Message>
@@ -156,7 +159,7 @@ void Mapper::subscribe(const std::string& topic) {
   inputs_.push_back(std::make_unique<SensorInput>());
   SensorInput* input = inputs_.back().get();
   input->subscriber = nh_.subscribe<Message>(
-      topic, static_cast<std::uint32_t>(config_.sensor_queue_size),
+      topic, static_cast<std::uint32_t>(config_.inputs.sensor_queue_size),
       [this, input](const boost::shared_ptr<const Message>& message) {
         receive(*input, {message->header, [this, message](const Eigen::Isometry3d& pose) {
                            if constexpr (std::is_same_v<Message, sensor_msgs::LaserScan>) {
@@ -178,7 +181,7 @@ void Mapper::receive(SensorInput& input, SensorMessage&& message) {
   std::lock_guard<std::mutex> lock(input.mutex);
   input.waiting.push_back(std::move(message));
   insertTransformable(input);
-  if (input.waiting.size() > static_cast<std::size_t>(config_.sensor_queue_size)) {
+  if (input.waiting.size() > static_cast<std::size_t>(config_.inputs.sensor_queue_size)) {
     dropForTransform(input.waiting.front().header,
                      "no transform to the map frame before ~sensor_queue_size newer messages");
     input.waiting.pop_front();
@@ -230,7 +233,7 @@ void Mapper::insertScan(const sensor_msgs::LaserScan& scan,
     std::size_t skipped = 0;
     PendingScan pending{
         laserScanToScan(scan, map_from_sensor, config_.insertion.max_range,
-                        static_cast<std::size_t>(config_.max_points_per_message), skipped),
+                        static_cast<std::size_t>(config_.inputs.max_points_per_message), skipped),
         "LaserScan"};
     counters_.readings_rejected += skipped;
     enqueue(std::move(pending));
@@ -242,11 +245,13 @@ void Mapper::insertScan(const sensor_msgs::LaserScan& scan,
 void Mapper::insertCloud(const sensor_msgs::PointCloud2& cloud,
                          const Eigen::Isometry3d& map_from_sensor) {
   try {
-    PendingScan pending{pointCloudToScan(cloud, map_from_sensor,
-                                         static_cast<std::size_t>(config_.max_points_per_message)),
-                        "PointCloud2"};
-    if (config_.voxel_filter_size > 0.0) {
-      counters_.readings_rejected += voxelFilter(pending.scan.hits, config_.voxel_filter_size);
+    PendingScan pending{
+        pointCloudToScan(cloud, map_from_sensor,
+                         static_cast<std::size_t>(config_.inputs.max_points_per_message)),
+        "PointCloud2"};
+    if (config_.inputs.voxel_filter_size > 0.0) {
+      counters_.readings_rejected +=
+          voxelFilter(pending.scan.hits, config_.inputs.voxel_filter_size);
     }
     enqueue(std::move(pending));
   } catch (const InvalidMessage& e) {
@@ -257,7 +262,7 @@ void Mapper::insertCloud(const sensor_msgs::PointCloud2& cloud,
 void Mapper::enqueue(PendingScan&& pending) {
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);
-    if (queue_.size() >= static_cast<std::size_t>(config_.insertion_queue_size)) {
+    if (queue_.size() >= static_cast<std::size_t>(config_.insertion.insertion_queue_size)) {
       queue_.pop_front();  // keep the newest: the oldest view is the least useful
       ++counters_.messages_dropped_queue;
       ROS_WARN_THROTTLE(kWarningPeriod,
@@ -464,7 +469,7 @@ void Mapper::publishStatistics(const ros::TimerEvent&) {
 
 void Mapper::decay(const ros::TimerEvent&) {
   std::unique_lock<WriterPreferringMutex> lock(map_mutex_);
-  map_.decay(config_.decay_factor);
+  map_.decay(config_.decay.decay_factor);
 }
 
 void Mapper::autosave() {
@@ -481,7 +486,8 @@ void Mapper::autosave() {
       bytes = mvog::serializeMap(map_);
     }
     // Written without the map's lock: insertion and queries go on meanwhile.
-    mvog::saveMapBytes(bytes, resolveMapPath(config_.map_directory, config_.autosave_file, true));
+    mvog::saveMapBytes(bytes, resolveMapPath(config_.map_files.map_directory,
+                                             config_.map_files.autosave_file, true));
     saved_generation_ = generation;
     saved_revision_ = revision;
   } catch (const std::exception& e) {
@@ -516,17 +522,18 @@ void Mapper::restartPublication() {
 
 bool Mapper::getOccupancy(mvog::GetOccupancy::Request& request,
                           mvog::GetOccupancy::Response& response) {
-  if (request.points.size() > static_cast<std::size_t>(config_.max_query_points)) {
+  if (request.points.size() > static_cast<std::size_t>(config_.queries.max_query_points)) {
     response.message = "refused: " + std::to_string(request.points.size()) +
                        " points exceed ~max_query_points (" +
-                       std::to_string(config_.max_query_points) + ")";
+                       std::to_string(config_.queries.max_query_points) + ")";
     return true;
   }
   Eigen::Isometry3d map_from_frame = Eigen::Isometry3d::Identity();
   if (!request.frame_id.empty() && request.frame_id != config_.frame_id) {
     try {
-      map_from_frame = tf2::transformToEigen(tf_buffer_.lookupTransform(
-          config_.frame_id, request.frame_id, ros::Time(0), ros::Duration(config_.tf_timeout)));
+      map_from_frame = tf2::transformToEigen(
+          tf_buffer_.lookupTransform(config_.frame_id, request.frame_id, ros::Time(0),
+                                     ros::Duration(config_.queries.tf_timeout)));
     } catch (const tf2::TransformException& e) {
       response.message = "cannot transform from '" + request.frame_id + "' to '" +
                          config_.frame_id + "': " + e.what();
@@ -586,7 +593,7 @@ bool Mapper::getCrossSection(mvog::GetCrossSection::Request& request,
 
 bool Mapper::saveMap(mvog::MapFile::Request& request, mvog::MapFile::Response& response) {
   try {
-    const std::string path = resolveMapPath(config_.map_directory, request.path, true);
+    const std::string path = resolveMapPath(config_.map_files.map_directory, request.path, true);
     std::vector<std::uint8_t> bytes;
     {
       std::shared_lock<WriterPreferringMutex> lock(map_mutex_);
@@ -603,7 +610,7 @@ bool Mapper::saveMap(mvog::MapFile::Request& request, mvog::MapFile::Response& r
 
 bool Mapper::loadMap(mvog::MapFile::Request& request, mvog::MapFile::Response& response) {
   try {
-    const std::string path = resolveMapPath(config_.map_directory, request.path, false);
+    const std::string path = resolveMapPath(config_.map_files.map_directory, request.path, false);
     mvog::Map loaded = mvog::loadMap(path);  // the current map stays untouched until this worked
     response.message = "loaded " + path;
     replaceMap(std::move(loaded));
