@@ -10,6 +10,10 @@
 
 namespace mvog_ros {
 
+/// s between two warnings of one kind (ROS_WARN_THROTTLE): bad input is counted in ~statistics
+/// and warned about now and then, not once per message.
+constexpr double kWarningPeriod = 5.0;
+
 // Every parameter of the mapping server, with its default, in one slice per part of the server.
 // Every field is named as its parameter. Read in one place (MapperConfig::fromParameters) and
 // validated at start: an invalid value refuses to start, naming the parameter.
