@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <nodelet/NodeletList.h>
@@ -604,6 +605,32 @@ TEST_F(Mapper, CountsReadingsAndDroppedMessages) {
   EXPECT_DOUBLE_EQ(statistics.resolution, kResolution);
   EXPECT_EQ(statistics.header.frame_id, "map");
   expectSceneAnswers();
+}
+
+/// The value of `key` in the status `name` of a /diagnostics message, or "" if it is not there.
+std::string diagnosticValue(const diagnostic_msgs::DiagnosticArray& array, const std::string& name,
+                            const std::string& key) {
+  for (const diagnostic_msgs::DiagnosticStatus& status : array.status) {
+    if (status.name != name) continue;
+    for (const diagnostic_msgs::KeyValue& value : status.values) {
+      if (value.key == key) return value.value;
+    }
+  }
+  return "";
+}
+
+TEST_F(Mapper, ReportsItsStatisticsOnDiagnostics) {
+  ros::NodeHandle nh;
+  Inbox<diagnostic_msgs::DiagnosticArray> diagnostics(nh, "/diagnostics");
+  mapScene();
+  const std::string status = server_->name().substr(1) + ": mapping";  // the node's name
+  const std::string inserted = std::to_string(kScans + kClouds);
+  EXPECT_TRUE(diagnostics.waitForMessage([&](const diagnostic_msgs::DiagnosticArray& array) {
+    return diagnosticValue(array, status, "messages_inserted") == inserted &&
+           diagnosticValue(array, status, "messages_dropped_queue") == "0" &&
+           diagnosticValue(array, status, "frame_id") == "map";
+  })) << "no status '"
+      << status << "' with " << inserted << " messages inserted";
 }
 
 TEST_F(Mapper, TransformsQueriesGivenInAnotherFrame) {
