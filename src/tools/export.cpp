@@ -10,7 +10,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -24,17 +23,9 @@ namespace {
 
 constexpr std::uint8_t kUnknownGrey = 205;
 
-/// Writes `contents` to `path` through a temporary file and a rename.
+/// Writes `contents` to `path` atomically (a temporary file, fsync, rename).
 void writeAtomically(const std::string& path, const std::string& contents) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    if (!out.flush()) throw std::runtime_error("cannot write " + temporary);
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    throw std::runtime_error("cannot rename " + temporary + " to " + path);
-  }
+  mvog::writeFileAtomically(contents.data(), contents.size(), path);
 }
 
 /// Grey levels row by row from the top (+y) down, as image viewers and map_server expect.
