@@ -89,7 +89,7 @@ mvog_add_gtest(test_mvog_ros
 # The server through its ROS interface, as node and as nodelet (test/ros/*.test).
 find_package(rostest REQUIRED)
 add_rostest_gtest(test_mapper_node test/ros/mapper_node.test test/ros/test_mapper_node.cpp)
-target_link_libraries(test_mapper_node mvog_ros)
+target_link_libraries(test_mapper_node mvog_ros mvog_scene)
 add_dependencies(test_mapper_node mvog_node)  # started by RefusedStart.*
 add_rostest(test/ros/mapper_nodelet.test DEPENDENCIES test_mapper_node)
 add_rostest(test/ros/decay.test DEPENDENCIES test_mapper_node)
