@@ -40,6 +40,7 @@ endif()
 mvog_add_gtest(test_mvog_core
   SOURCES test/core/test_volume.cpp test/core/test_raster.cpp test/core/test_insertion.cpp
           test/core/test_queries.cpp test/core/test_map.cpp test/core/test_map_io.cpp
+          test/core/test_column.cpp test/core/test_height_colour.cpp
   LIBRARIES mvog_core)
 # A process saving maps, killed at random moments: the file always loads (RELIABILITY.md).
 mvog_add_gtest(test_save_sigkill
@@ -85,6 +86,8 @@ endif()
 # ---- The mapping server (include/mvog_ros, src/ros) -----------------------------------------
 mvog_add_gtest(test_mvog_ros
   SOURCES test/ros/test_map_paths.cpp test/ros/test_mapper_config.cpp
+          test/ros/test_visualization.cpp test/ros/test_incremental_grid.cpp
+          test/ros/test_insertion_worker.cpp
   LIBRARIES mvog_ros)
 # The server through its ROS interface, as node and as nodelet (test/ros/*.test).
 find_package(rostest REQUIRED)
