@@ -52,7 +52,7 @@ class InsertionWorker {
   /// The worker's one call into the core: `scan` into the map, under the map's write lock.
   mvog::InsertionResult insert(const mvog::Scan& scan);
 
-  const InsertionWorkerConfig& config_;
+  const InsertionWorkerConfig config_;
   SharedMap& map_;
 
   std::mutex queue_mutex_;

@@ -40,8 +40,8 @@ using EnqueueScan = std::function<void(mvog::Scan&& scan, const std::string& sou
 /// What every sensor input is given: its parameters, the map frame, the tf buffer to wait on,
 /// the counters of what it drops, and where converted messages go.
 struct SensorInputContext {
-  const SensorInputsConfig& config;
-  const std::string& frame_id;
+  SensorInputsConfig config;
+  std::string frame_id;
   const tf2_ros::Buffer& tf_buffer;
   InputCounters& counters;
   EnqueueScan enqueue;

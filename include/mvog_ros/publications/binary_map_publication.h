@@ -24,7 +24,7 @@ class BinaryMapPublication {
   /// The whole map as a message; the caller holds the map's lock.
   mvog::MapBinary message() const;
 
-  const std::string& frame_id_;
+  const std::string frame_id_;
   const SharedMap& map_;
 
   std::mutex mutex_;      // published_, and one publication at a time

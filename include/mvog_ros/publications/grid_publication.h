@@ -43,7 +43,7 @@ class GridPublication : public ChangePublication {
   std::optional<mvog::CellRange> update(Layer& layer, const std::vector<mvog::TileIndex>& changed,
                                         bool& relaid_out);
 
-  const std::string& frame_id_;
+  const std::string frame_id_;
   const int max_cross_section_cells_;
   std::vector<Layer> layers_;  // the projected map, then one per ~cross_section_heights entry
 };

@@ -27,7 +27,7 @@ class MarkerPublication : public ChangePublication {
   void publishTiles(const std::vector<mvog::TileIndex>& changed) override;
   void sendAll(const ros::SingleSubscriberPublisher& subscriber, bool occupied_only);
 
-  const std::string& frame_id_;
+  const std::string frame_id_;
   const double occupancy_threshold_;
   ros::Publisher volumes_publisher_;
   ros::Publisher occupied_publisher_;

@@ -32,7 +32,7 @@ class StatisticsPublication {
   /// The status "mapping" from the latest statistics, compared with those before.
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
-  const std::string& frame_id_;
+  const std::string frame_id_;
   const SharedMap& map_;
   const SensorInputs& inputs_;
   const InsertionWorker& insertion_;

@@ -37,7 +37,7 @@ class MapFileServices {
   /// Saves ~autosave_file if the map changed since the last autosave (a warning if it fails).
   void autosave();
 
-  const MapFilesConfig& config_;
+  const MapFilesConfig config_;
   const SharedMap& map_;
   const ReplaceMap replace_map_;
 

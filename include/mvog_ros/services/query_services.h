@@ -27,8 +27,8 @@ class QueryServices {
   bool getCrossSection(mvog::GetCrossSection::Request& request,
                        mvog::GetCrossSection::Response& response);
 
-  const QueryServicesConfig& config_;
-  const std::string& frame_id_;
+  const QueryServicesConfig config_;
+  const std::string frame_id_;
   const double occupancy_threshold_;
   const int max_cross_section_cells_;
   const double max_coordinate_;  // ~max_coordinate: no rectangle beyond it is cut
