@@ -16,9 +16,9 @@ MVOG_PACKAGES=(
   build-essential cmake libeigen3-dev libgtest-dev libbenchmark-dev
   ros-core-python-dev ros-base-dev python3-rostest rosbash python3-rosbag python3-numpy
   python3-rospy python3-sensor-msgs python3-geometry-msgs python3-tf2-msgs python3-tf2-ros
-  libpcl-ros-dev libpcl-conversions-dev libtf2-ros-dev libtf2-sensor-msgs-dev libtf2-eigen-dev
-  libtf2-geometry-msgs-dev liblaser-geometry-dev libstd-srvs-dev libvisualization-msgs-dev
-  libnav-msgs-dev libmap-msgs-dev libdiagnostic-msgs-dev rviz tf2-tools liboctomap-dev octomap-tools
+  libpcl-dev libtf2-ros-dev libtf2-eigen-dev libtf2-msgs-dev libstd-srvs-dev
+  libvisualization-msgs-dev libnav-msgs-dev libmap-msgs-dev libdiagnostic-updater-dev
+  rviz tf2-tools liboctomap-dev octomap-tools
   xvfb xauth x11-utils libgl1-mesa-dri imagemagick
   clang-14 libclang-rt-14-dev clang-format-14
 )

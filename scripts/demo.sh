@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The main job: installs what is missing, builds, generates the embedded default recording (a
 # MAV with a depth camera and a tilted laser in an office while a person walks in and out),
-# replays it through mapper.launch with `rosbag play --clock`, then saves the map, writes two
-# cross-sections and the projected map as map_server PGM + YAML, a screenshot of rviz (under
-# Xvfb) and a rendered PNG of the occupied space, and prints the statistics and what it wrote.
+# replays it through mapper.launch with `rosbag play --clock` once the mapper has subscribed,
+# then saves the map, writes the cross-sections and the projected map as map_server PGM + YAML, a
+# rendered PNG of the occupied space and a screenshot of rviz (under Xvfb) framed on the map, and
+# prints what the mapper did with the bag's sensor messages and the line to source to use it.
 #
 #   scripts/demo.sh [--bag FILE] [--scan-topic T] [--cloud-topic T] [--resolution R]
 #                   [--config YAML] [--heights "Z1 Z2"] [--rate X] [--output DIR]
@@ -31,6 +32,10 @@ while [ $# -gt 0 ]; do
     *) echo "unknown option: $1 (see --help)" >&2; exit 2 ;;
   esac
 done
+# Topics as a bag names them.
+[[ $scan_topic == /* ]] || scan_topic=/$scan_topic
+[[ $cloud_topic == /* ]] || cloud_topic=/$cloud_topic
+read -r -a height_list <<<"$heights"
 
 install_missing_packages
 build_workspace
@@ -47,12 +52,28 @@ if [ -z "$bag" ]; then
   fi
 fi
 
+# The bag's sensor messages on the two topics, and how long it plays.
+read -r bag_scans bag_clouds bag_seconds < <(python3 - "$bag" "$scan_topic" "$cloud_topic" <<'PY'
+import sys
+import rosbag
+with rosbag.Bag(sys.argv[1]) as bag:
+    topics = bag.get_type_and_topic_info().topics
+    counts = [topics[t].message_count if t in topics else 0 for t in sys.argv[2:4]]
+    print(counts[0], counts[1], bag.get_end_time() - bag.get_start_time())
+PY
+)
+bag_messages=$((bag_scans + bag_clouds))
+if [ "$bag_messages" -eq 0 ]; then
+  echo "$bag holds no message on $scan_topic or $cloud_topic (see --scan-topic, --cloud-topic)" >&2
+  exit 1
+fi
+
 start_private_master demo
 
-heights_yaml="[$(tr -s ' ' ',' <<<"$heights")]"
+heights_yaml="[$(IFS=,; echo "${height_list[*]}")]"
 roslaunch mvog mapper.launch use_sim_time:=true resolution:="$resolution" \
   scan_topic:="$scan_topic" cloud_topic:="$cloud_topic" map_directory:="$output" \
-  config:="$config" >"$LOG_DIR/demo-mapper.log" 2>&1 &
+  config:="$config" cross_section_heights:="$heights_yaml" >"$LOG_DIR/demo-mapper.log" 2>&1 &
 BACKGROUND_PIDS+=($!)
 until rosservice list 2>/dev/null | grep -q /mvog_mapper/save_map; do
   if ! kill -0 "${BACKGROUND_PIDS[-1]}" 2>/dev/null; then
@@ -62,7 +83,81 @@ until rosservice list 2>/dev/null | grep -q /mvog_mapper/save_map; do
   fi
   sleep 0.5
 done
-rosparam set /mvog_mapper/cross_section_heights "$heights_yaml" 2>/dev/null || true
+
+echo "replaying $bag ..."
+# Only the sensor topics and tf, each played once the mapper has subscribed to it: no first
+# message is lost. --keep-alive keeps the clock going past the bag's end, so that the mapper's
+# timers (statistics, publication, decay) run on while it inserts what it still holds.
+rosbag play --clock --keep-alive --wait-for-subscribers -q -r "$rate" "$bag" \
+  --topics "$scan_topic" "$cloud_topic" /tf /tf_static >"$LOG_DIR/demo-rosbag.log" 2>&1 &
+player=$!
+BACKGROUND_PIDS+=($player)
+# Until the statistics account for every sensor message of the bag (inserted or dropped for a
+# reason they count); messages lost uncounted would keep them short, so also until they have
+# stood still for 10 s once the bag has played.
+python3 - "$bag_messages" "$bag_seconds" "$rate" <<'PY'
+import sys
+import time
+import rospy
+from mvog.msg import MapStatistics
+expected, play_seconds = int(sys.argv[1]), float(sys.argv[2]) / float(sys.argv[3])
+rospy.init_node("demo_replay_wait", anonymous=True, disable_signals=True)
+latest = []
+rospy.Subscriber("/mvog_mapper/statistics", MapStatistics, latest.append)
+start = time.monotonic()
+counts, changed = None, start
+while time.monotonic() - start < play_seconds + 600:
+    time.sleep(0.5)
+    if not latest:
+        continue
+    s = latest[-1]
+    now = (s.messages_inserted, s.messages_dropped_tf, s.messages_dropped_queue,
+           s.messages_dropped_invalid)
+    if now != counts:
+        counts, changed = now, time.monotonic()
+    if sum(counts) >= expected:
+        break
+    if time.monotonic() - start > play_seconds + 10 and time.monotonic() - changed > 10:
+        break
+PY
+kill -INT "$player" 2>/dev/null || true
+wait "$player" 2>/dev/null || true
+
+rosservice call /mvog_mapper/save_map "path: 'demo.mvog'" >"$LOG_DIR/demo-save.log"
+grep -q 'success: True' "$LOG_DIR/demo-save.log" || { cat "$LOG_DIR/demo-save.log"; exit 1; }
+map=$output/demo.mvog
+
+export_args=()
+for z in "${height_list[@]}"; do export_args+=(--cross-section "$z" "$output/cross_section_${z}m"); done
+export_args+=(--projection 0.1 2.0 "$output/projected_map" --render "$output/occupied.png")
+rosrun mvog mvog_export "$map" "${export_args[@]}" >"$LOG_DIR/demo-export.log"
+
+# rviz's view framed on the map (its extent from the projected map), for the screenshot and for
+# `rviz -d $output/mvog.rviz`.
+python3 - "$REPO/rviz/mvog.rviz" "$output/projected_map" "$scan_topic" "$cloud_topic" \
+  >"$output/mvog.rviz" <<'PY'
+import re
+import sys
+template, projection, scan_topic, cloud_topic = sys.argv[1:5]
+resolution = origin = None
+for line in open(projection + ".yaml"):
+    if line.startswith("resolution:"):
+        resolution = float(line.split(":", 1)[1])
+    elif line.startswith("origin:"):
+        origin = [float(v) for v in line.split(":", 1)[1].strip(" []\n").split(",")]
+with open(projection + ".pgm", "rb") as pgm:
+    width, height = (int(v) for v in pgm.read(64).split()[1:3])
+extent = max(width, height) * resolution
+view = "Distance: %.2f\n      Focal Point:\n        X: %.2f\n        Y: %.2f\n" % (
+    max(4.0, 1.75 * extent), origin[0] + 0.5 * width * resolution,
+    origin[1] + 0.5 * height * resolution)
+text = open(template).read()
+text = re.sub(r"Distance: [-0-9.]+\n      Focal Point:\n        X: [-0-9.]+\n        Y: [-0-9.]+\n",
+              view, text)
+text = text.replace("Topic: /scan\n", "Topic: %s\n" % scan_topic)
+text = text.replace("Topic: /camera/depth/points\n", "Topic: %s\n" % cloud_topic)
+sys.stdout.write(text)
+PY
 
 screenshot=""
 if command -v Xvfb >/dev/null && command -v rviz >/dev/null; then
@@ -72,41 +167,29 @@ if command -v Xvfb >/dev/null && command -v rviz >/dev/null; then
   BACKGROUND_PIDS+=($!)
   for _ in $(seq 50); do [ -s "$LOG_DIR/demo-xvfb-display" ] && break; sleep 0.2; done
   display=:$(cat "$LOG_DIR/demo-xvfb-display")
-  DISPLAY=$display rviz -d "$REPO/rviz/mvog.rviz" >"$LOG_DIR/demo-rviz.log" 2>&1 &
+  DISPLAY=$display rviz -d "$output/mvog.rviz" >"$LOG_DIR/demo-rviz.log" 2>&1 &
   BACKGROUND_PIDS+=($!)
-fi
-
-echo "replaying $bag ..."
-rosbag play --clock -q -r "$rate" "$bag" >"$LOG_DIR/demo-rosbag.log" 2>&1
-# Let the mapper drain its queue and publish once more.
-previous=-1
-for _ in $(seq 30); do
-  inserted=$(rostopic echo -n 1 /mvog_mapper/statistics/messages_inserted 2>/dev/null | head -1 || true)
-  [ "$inserted" = "$previous" ] && break
-  previous=$inserted
-  sleep 2
-done
-
-rosservice call /mvog_mapper/save_map "path: 'demo.mvog'" >"$LOG_DIR/demo-save.log"
-grep -q 'success: True' "$LOG_DIR/demo-save.log" || { cat "$LOG_DIR/demo-save.log"; exit 1; }
-map=$output/demo.mvog
-
-if [ ${#BACKGROUND_PIDS[@]} -gt 2 ] && DISPLAY=$display xwininfo -root >/dev/null 2>&1; then
-  sleep 3
+  # Once rviz has subscribed to the markers (sent whole to a new subscriber), time to draw them.
+  for _ in $(seq 120); do
+    rostopic info /mvog_mapper/occupied 2>/dev/null | sed -n '/Subscribers:/,$p' | grep -q rviz &&
+      break
+    sleep 0.5
+  done
+  sleep 5
   DISPLAY=$display import -window root "$output/rviz.png" 2>>"$LOG_DIR/demo-screenshot.log" &&
     screenshot=$output/rviz.png
 fi
 
-export_args=()
-for z in $heights; do export_args+=(--cross-section "$z" "$output/cross_section_${z}m"); done
-export_args+=(--projection 0.1 2.0 "$output/projected_map" --render "$output/occupied.png")
-rosrun mvog mvog_export "$map" "${export_args[@]}" >"$LOG_DIR/demo-export.log"
-
 echo
+rostopic echo -n 1 /mvog_mapper/statistics >"$LOG_DIR/demo-statistics.log" 2>/dev/null
+statistic() { sed -n "s/^$1: //p" "$LOG_DIR/demo-statistics.log"; }
+echo "sensor messages in the bag: $bag_messages ($bag_scans LaserScan on $scan_topic," \
+  "$bag_clouds PointCloud2 on $cloud_topic); inserted $(statistic messages_inserted)," \
+  "dropped $(statistic messages_dropped_tf) without transform," \
+  "$(statistic messages_dropped_queue) for a full queue, $(statistic messages_dropped_invalid) invalid"
 echo "statistics:"
-rostopic echo -n 1 /mvog_mapper/statistics 2>/dev/null |
-  grep -E 'cells_with_volumes|_volumes|bytes_held|table_one|readings_inserted|readings_rejected|insertion_seconds|messages_' |
-  sed 's/^/  /'
+grep -E 'cells_with_volumes|_volumes|bytes_held|table_one|readings_inserted|readings_rejected|insertion_seconds' \
+  "$LOG_DIR/demo-statistics.log" | sed 's/^/  /'
 if [ -f "$output/scene_truth.json" ] && [ "$bag" = "$output/scene.bag" ]; then
   python3 - "$output/scene_truth.json" <<'PY'
 import json, subprocess, sys
@@ -125,8 +208,12 @@ fi
 echo
 echo "wrote:"
 echo "  map             $map"
-for z in $heights; do echo "  cross-section   $output/cross_section_${z}m.pgm (.yaml)"; done
+for z in "${height_list[@]}"; do echo "  cross-section   $output/cross_section_${z}m.pgm (.yaml)"; done
 echo "  projected map   $output/projected_map.pgm (.yaml)"
 echo "  occupied space  $output/occupied.png"
+echo "  rviz view       $output/mvog.rviz"
 [ -n "$screenshot" ] && echo "  rviz            $screenshot"
 echo "  logs            $LOG_DIR"
+echo
+echo "to use this build (roslaunch mvog mapper.launch, rosrun mvog mvog_export, rviz -d ...):"
+echo "  source $WORKSPACE/devel/setup.bash"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sanitizer builds and fuzzing (see RELIABILITY.md) in $WORKSPACE/sanitizers: plain CMake builds
-# (test/sanitizers) and an instrumented catkin workspace:
+# (test/sanitizers, the programs of test/tests.cmake) and an instrumented catkin workspace:
 #   address  g++, AddressSanitizer + UndefinedBehaviorSanitizer (no recovery): the core gtests,
 #            the ROS conversion gtests, the concurrency and SIGKILL-during-save tests, and the
 #            fuzz corpora and regressions replayed through the fuzz targets' entry points;
@@ -56,11 +56,11 @@ check() {
 
 asan_checks=(asan-core-gtests asan-conversions-gtests asan-concurrency asan-save-sigkill
              asan-replay-map_file asan-replay-conversions)
-if build address g++ test_mvog_core test_conversions test_concurrency test_save_sigkill \
+if build address g++ test_mvog_core test_mvog_ros_conversions test_concurrency test_save_sigkill \
   fuzz_replay_map_file fuzz_replay_conversions; then
-  dir=$BUILD_ROOT/address
-  check asan-core-gtests "$dir/mvog/test_mvog_core"
-  check asan-conversions-gtests "$dir/test_conversions"
+  dir=$BUILD_ROOT/address/mvog
+  check asan-core-gtests "$dir/test_mvog_core"
+  check asan-conversions-gtests "$dir/test_mvog_ros_conversions"
   check asan-concurrency "$dir/test_concurrency"
   check asan-save-sigkill "$dir/test_save_sigkill"
   for target in map_file conversions; do
@@ -114,7 +114,7 @@ else
 fi
 
 if build thread g++ test_concurrency; then
-  check tsan-concurrency "$BUILD_ROOT/thread/test_concurrency"
+  check tsan-concurrency "$BUILD_ROOT/thread/mvog/test_concurrency"
 else
   fail "tsan-concurrency: the thread build failed"
 fi
@@ -125,7 +125,7 @@ if build fuzz clang++-14 fuzz_map_file fuzz_conversions; then
     mkdir -p "$BUILD_ROOT/fuzz/corpus/$target"
     seeds=("$REPO/test/fuzz/corpus/$target")
     [ -d "$REPO/test/fuzz/regressions/$target" ] && seeds+=("$REPO/test/fuzz/regressions/$target")
-    check "fuzz-$target" "$BUILD_ROOT/fuzz/fuzz_$target" -max_total_time="$FUZZ_SECONDS" \
+    check "fuzz-$target" "$BUILD_ROOT/fuzz/mvog/fuzz_$target" -max_total_time="$FUZZ_SECONDS" \
       -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
       -artifact_prefix="$FUZZ_LOGS/$target-" "$BUILD_ROOT/fuzz/corpus/$target" "${seeds[@]}"
   done

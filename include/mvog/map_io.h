@@ -46,14 +46,18 @@ std::vector<std::uint8_t> serializeMap(const Map& map);
 /// Throws MapFileError if `data` is not a complete, valid map (nothing is half-loaded).
 Map deserializeMap(const std::uint8_t* data, std::size_t size);
 
-/// Writes atomically: a temporary file in the same directory (`.NAME.saving-XXXXXX`), fsync,
-/// then rename over `path`. Throws MapFileError on failure (and leaves any previous file at `path`
-/// untouched). Also removes the temporaries that earlier saves of `path`, killed before their
-/// rename, left beside it (on a local file system with flock).
+/// Writes atomically (writeFileAtomically). Throws MapFileError on failure (and leaves any
+/// previous file at `path` untouched).
 void saveMap(const Map& map, const std::string& path);
 /// The same for bytes of serializeMap: a caller that shares the map with other threads can
 /// serialise under its lock and write after releasing it.
 void saveMapBytes(const std::vector<std::uint8_t>& bytes, const std::string& path);
+/// Writes `size` bytes to `path` atomically, whatever they are (maps, the exported images): a
+/// temporary file in the same directory (`.NAME.saving-XXXXXX`), fsync, rename over `path`, fsync
+/// of the directory. Throws MapFileError on failure (and leaves any previous file at `path`
+/// untouched). Also removes the temporaries that earlier writes of `path`, killed before their
+/// rename, left beside it (on a local file system with flock).
+void writeFileAtomically(const void* data, std::size_t size, const std::string& path);
 /// Throws MapFileError if the file cannot be read or is not a valid map.
 Map loadMap(const std::string& path);
 

@@ -28,6 +28,9 @@ class ScanUpdate {
   void prepare(const Scan& scan, const MapConfig& map_config, const InsertionConfig& insertion);
   /// What happened to the readings of the scan last prepared.
   const InsertionResult& result() const;
+  /// Whether the scan last prepared can be applied to a map of `map_config` (same resolution,
+  /// max_coordinate and rules).
+  bool preparedFor(const MapConfig& map_config) const;
 
  private:
   friend class Map;

@@ -315,9 +315,7 @@ InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::V
 
 InsertionResult Map::apply(ScanUpdate& update) {
   ScanUpdate::Impl& impl = *update.impl_;
-  if (impl.map_config.resolution != config_.resolution ||
-      impl.map_config.max_coordinate != config_.max_coordinate ||
-      !(impl.map_config.rules == config_.rules)) {
+  if (!update.preparedFor(config_)) {
     throw ConfigError("update: prepared for another map configuration");
   }
   std::vector<std::uint64_t> keys;

@@ -319,6 +319,11 @@ void removeLeftoverTemporaries(const std::string& path) {
 void saveMap(const Map& map, const std::string& path) { saveMapBytes(serializeMap(map), path); }
 
 void saveMapBytes(const std::vector<std::uint8_t>& bytes, const std::string& path) {
+  writeFileAtomically(bytes.data(), bytes.size(), path);
+}
+
+void writeFileAtomically(const void* data, std::size_t size, const std::string& path) {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
   removeLeftoverTemporaries(path);
   std::string temporary;
   const int fd = createLockedTemporary(path, temporary);
@@ -328,8 +333,8 @@ void saveMapBytes(const std::vector<std::uint8_t>& bytes, const std::string& pat
     throw MapFileError(message);
   };
   std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+  while (written < size) {
+    const ssize_t n = ::write(fd, bytes + written, size - written);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) abandon(systemError("cannot write", temporary));
     written += static_cast<std::size_t>(n);

@@ -266,6 +266,12 @@ ScanUpdate& ScanUpdate::operator=(ScanUpdate&&) noexcept = default;
 
 const InsertionResult& ScanUpdate::result() const { return impl_->result; }
 
+bool ScanUpdate::preparedFor(const MapConfig& map_config) const {
+  const MapConfig& prepared = impl_->map_config;
+  return prepared.resolution == map_config.resolution &&
+         prepared.max_coordinate == map_config.max_coordinate && prepared.rules == map_config.rules;
+}
+
 void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
                          const InsertionConfig& insertion) {
   map_config.validate();

@@ -1,4 +1,4 @@
-#include "conversions.h"
+#include "mvog_ros/conversions.h"
 
 #include <algorithm>
 #include <cmath>
@@ -31,9 +31,9 @@ double readCoordinate(const std::uint8_t* at, std::uint8_t datatype, bool swap_b
 
 }  // namespace
 
-mvog::Scan scanToReadings(const sensor_msgs::LaserScan& scan,
-                          const Eigen::Isometry3d& map_from_sensor, double max_free_range,
-                          std::size_t max_beams, std::size_t& skipped_beams) {
+mvog::Scan laserScanToScan(const sensor_msgs::LaserScan& scan,
+                           const Eigen::Isometry3d& map_from_sensor, double max_free_range,
+                           std::size_t max_beams, std::size_t& skipped_beams) {
   if (scan.ranges.empty()) throw InvalidMessage("LaserScan has no beams");
   if (scan.ranges.size() > max_beams) {
     throw InvalidMessage("LaserScan has " + std::to_string(scan.ranges.size()) +
@@ -69,8 +69,8 @@ mvog::Scan scanToReadings(const sensor_msgs::LaserScan& scan,
   return readings;
 }
 
-mvog::Scan cloudToReadings(const sensor_msgs::PointCloud2& cloud,
-                           const Eigen::Isometry3d& map_from_sensor, std::size_t max_points) {
+mvog::Scan pointCloudToScan(const sensor_msgs::PointCloud2& cloud,
+                            const Eigen::Isometry3d& map_from_sensor, std::size_t max_points) {
   const std::uint64_t num_points = std::uint64_t{cloud.width} * cloud.height;
   if (num_points > max_points) {
     throw InvalidMessage("PointCloud2 has " + std::to_string(num_points) +

@@ -1,4 +1,4 @@
-#include "map_paths.h"
+#include "mvog_ros/map_paths.h"
 
 #include <sys/stat.h>
 

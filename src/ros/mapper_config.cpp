@@ -1,9 +1,10 @@
-#include "mapper_config.h"
+#include "mvog_ros/mapper_config.h"
 
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 
+#include <ros/console.h>
 #include <ros/names.h>
 
 namespace mvog_ros {
@@ -103,34 +104,72 @@ std::string defaultMapDirectory() {
   return "mvog_maps";
 }
 
-}  // namespace
-
-void MapperConfig::validate() const {
-  // The core's own checks name their field, which is the parameter's name: prefix it with ~.
+/// Runs a core config's own checks: they name their field, which is the parameter's name.
+template <class CoreConfig>
+void validateCoreConfig(const CoreConfig& config) {
   try {
-    map.validate();
-    insertion.validate();
+    config.validate();
   } catch (const mvog::ConfigError& e) {
     throw mvog::ConfigError(std::string("~") + e.what());
   }
-  require(!frame_id.empty() && frame_id.front() != '/', "frame_id",
-          "must be a non-empty tf2 frame id (without a leading '/')");
+}
+
+/// ~model (the rules' preset), then each rule on its own (README, the rules table).
+void readModel(const ros::NodeHandle& nh, MapperConfig& config) {
+  std::string model = "default";
+  read(nh, "model", model);
+  if (model == "paper") {
+    config.map.rules = mvog::ModelRules::paper();
+    config.occupancy_threshold = mvog::kPaperOccupancyThreshold;
+  } else {
+    require(model == "default", "model", "must be 'default' or 'paper', not '" + model + "'");
+  }
+  mvog::ModelRules& rules = config.map.rules;
+  if (nh.hasParam("clear_conflicting_free_space")) {
+    // The parameter of the first release: a scan's conflicting free space was dropped whole.
+    ROS_WARN(
+        "mvog: ~clear_conflicting_free_space is replaced by ~clip_free_space_at_hits (on by "
+        "default): its value is taken for it");
+    read(nh, "clear_conflicting_free_space", rules.clip_free_space_at_hits);
+  }
+  read(nh, "clip_free_space_at_hits", rules.clip_free_space_at_hits);
+  read(nh, "split_free_space_at_obstacles", rules.split_free_space_at_obstacles);
+  std::string counting;
+  read(nh, "mass_counting", counting);
+  if (!counting.empty()) {
+    require(counting == "per_scan" || counting == "per_reading", "mass_counting",
+            "must be 'per_scan' or 'per_reading', not '" + counting + "'");
+    rules.mass_counting =
+        counting == "per_scan" ? mvog::MassCounting::kPerScan : mvog::MassCounting::kPerReading;
+  }
+  read(nh, "out_of_range_free_length", rules.out_of_range_free_length);
+}
+
+}  // namespace
+
+void SensorInputsConfig::validate() const {
   requireTopics(scan_topics, "scan_topics");
   requireTopics(cloud_topics, "cloud_topics");
   require(sensor_queue_size >= 1 && sensor_queue_size <= 1000, "sensor_queue_size",
           "must be in [1, 1000]");
-  require(insertion_queue_size >= 1 && insertion_queue_size <= 1000, "insertion_queue_size",
-          "must be in [1, 1000]");
-  requireDuration(tf_timeout, "tf_timeout", "no waiting");
   require(std::isfinite(voxel_filter_size) && voxel_filter_size >= 0.0, "voxel_filter_size",
           "must be a finite number >= 0 (0: off)");
   require(max_points_per_message >= 1, "max_points_per_message", "must be >= 1");
+}
+
+void InsertionWorkerConfig::validate() const {
+  validateCoreConfig<mvog::InsertionConfig>(*this);
+  require(insertion_queue_size >= 1 && insertion_queue_size <= 1000, "insertion_queue_size",
+          "must be in [1, 1000]");
+}
+
+void DecayConfig::validate() const {
   require(std::isfinite(decay_factor) && decay_factor > 0.0 && decay_factor <= 1.0, "decay_factor",
           "must be in (0, 1]");
   requireDuration(decay_period, "decay_period", "off");
-  require(
-      std::isfinite(occupancy_threshold) && occupancy_threshold >= 0.0 && occupancy_threshold < 1.0,
-      "occupancy_threshold", "must be in [0, 1)");
+}
+
+void PublicationsConfig::validate(const mvog::MapConfig& map) const {
   for (double height : cross_section_heights) {
     require(std::isfinite(height) && std::fabs(height) <= map.max_coordinate,
             "cross_section_heights", "every height must be finite and within max_coordinate");
@@ -142,50 +181,82 @@ void MapperConfig::validate() const {
   requireDuration(publish_period, "publish_period", nullptr);
   requireDuration(binary_map_period, "binary_map_period", "off");
   requireDuration(statistics_period, "statistics_period", nullptr);
+}
+
+void QueryServicesConfig::validate() const {
+  requireDuration(tf_timeout, "tf_timeout", "no waiting");
+  require(max_query_points >= 1, "max_query_points", "must be >= 1");
+}
+
+void MapFilesConfig::validate() const {
   require(!map_directory.empty(), "map_directory", "must not be empty");
   requireDuration(autosave_period, "autosave_period", "off");
   require(autosave_period == 0.0 || !autosave_file.empty(), "autosave_file",
           "must not be empty when ~autosave_period is set");
-  require(max_query_points >= 1, "max_query_points", "must be >= 1");
+}
+
+void MapperConfig::validate() const {
+  validateCoreConfig(map);
+  require(!frame_id.empty() && frame_id.front() != '/', "frame_id",
+          "must be a non-empty tf2 frame id (without a leading '/')");
+  require(
+      std::isfinite(occupancy_threshold) && occupancy_threshold >= 0.0 && occupancy_threshold < 1.0,
+      "occupancy_threshold", "must be in [0, 1)");
   require(max_cross_section_cells >= 1 && max_cross_section_cells <= kMaxGridCells,
           "max_cross_section_cells", "must be in [1, 2^28]");
+  inputs.validate();
+  insertion.validate();
+  decay.validate();
+  publications.validate(map);
+  queries.validate();
+  map_files.validate();
 }
 
 MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   MapperConfig config;
-  config.map_directory = defaultMapDirectory();
+  config.map_files.map_directory = defaultMapDirectory();
   const ros::NodeHandle& nh = private_nh;
   read(nh, "resolution", config.map.resolution);
   read(nh, "max_coordinate", config.map.max_coordinate);
-  read(nh, "min_range", config.insertion.min_range);
-  read(nh, "max_range", config.insertion.max_range);
-  read(nh, "insert_out_of_range", config.insertion.insert_out_of_range);
-  read(nh, "model_negative_space", config.insertion.model_negative_space);
-  read(nh, "clear_conflicting_free_space", config.map.rules.clip_free_space_at_hits);
-  read(nh, "insertion_threads", config.insertion.insertion_threads);
+  readModel(nh, config);
   read(nh, "frame_id", config.frame_id);
-  read(nh, "scan_topics", config.scan_topics);
-  read(nh, "cloud_topics", config.cloud_topics);
-  read(nh, "sensor_queue_size", config.sensor_queue_size);
-  read(nh, "insertion_queue_size", config.insertion_queue_size);
-  read(nh, "tf_timeout", config.tf_timeout);
-  read(nh, "voxel_filter_size", config.voxel_filter_size);
-  read(nh, "max_points_per_message", config.max_points_per_message);
-  read(nh, "decay_factor", config.decay_factor);
-  read(nh, "decay_period", config.decay_period);
   read(nh, "occupancy_threshold", config.occupancy_threshold);
-  read(nh, "cross_section_heights", config.cross_section_heights);
-  read(nh, "projection_min_z", config.projection_min_z);
-  read(nh, "projection_max_z", config.projection_max_z);
-  read(nh, "publish_period", config.publish_period);
-  read(nh, "binary_map_period", config.binary_map_period);
-  read(nh, "statistics_period", config.statistics_period);
-  read(nh, "map_directory", config.map_directory);
-  read(nh, "map_file", config.map_file);
-  read(nh, "autosave_period", config.autosave_period);
-  read(nh, "autosave_file", config.autosave_file);
-  read(nh, "max_query_points", config.max_query_points);
   read(nh, "max_cross_section_cells", config.max_cross_section_cells);
+
+  SensorInputsConfig& inputs = config.inputs;
+  read(nh, "scan_topics", inputs.scan_topics);
+  read(nh, "cloud_topics", inputs.cloud_topics);
+  read(nh, "sensor_queue_size", inputs.sensor_queue_size);
+  read(nh, "voxel_filter_size", inputs.voxel_filter_size);
+  read(nh, "max_points_per_message", inputs.max_points_per_message);
+
+  InsertionWorkerConfig& insertion = config.insertion;
+  read(nh, "min_range", insertion.min_range);
+  read(nh, "max_range", insertion.max_range);
+  read(nh, "insert_out_of_range", insertion.insert_out_of_range);
+  read(nh, "model_negative_space", insertion.model_negative_space);
+  read(nh, "insertion_threads", insertion.insertion_threads);
+  read(nh, "insertion_queue_size", insertion.insertion_queue_size);
+
+  read(nh, "decay_factor", config.decay.decay_factor);
+  read(nh, "decay_period", config.decay.decay_period);
+
+  PublicationsConfig& publications = config.publications;
+  read(nh, "cross_section_heights", publications.cross_section_heights);
+  read(nh, "projection_min_z", publications.projection_min_z);
+  read(nh, "projection_max_z", publications.projection_max_z);
+  read(nh, "publish_period", publications.publish_period);
+  read(nh, "binary_map_period", publications.binary_map_period);
+  read(nh, "statistics_period", publications.statistics_period);
+
+  read(nh, "tf_timeout", config.queries.tf_timeout);
+  read(nh, "max_query_points", config.queries.max_query_points);
+
+  MapFilesConfig& map_files = config.map_files;
+  read(nh, "map_directory", map_files.map_directory);
+  read(nh, "map_file", map_files.map_file);
+  read(nh, "autosave_period", map_files.autosave_period);
+  read(nh, "autosave_file", map_files.autosave_file);
   config.validate();
   return config;
 }

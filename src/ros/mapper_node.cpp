@@ -1,7 +1,7 @@
 // The mapping server as a standalone node (the same Mapper as the nodelet).
 #include <ros/ros.h>
 
-#include "mapper.h"
+#include "mvog_ros/mapper.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "mvog_mapper");

@@ -3,7 +3,7 @@
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 
-#include "mapper.h"
+#include "mvog_ros/mapper.h"
 
 namespace mvog_ros {
 

@@ -1,14 +1,16 @@
-#include "visualization.h"
+#include "mvog_ros/visualization.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "mvog/column.h"
+#include "mvog/height_colour.h"
 
 namespace mvog_ros {
 namespace {
 
 constexpr int kMarginTiles = 4;
+constexpr double kColourMapTop = 3.0;  // m: occupied space is red at this height and above
 
 std_msgs::ColorRGBA colour(float r, float g, float b, float a) {
   std_msgs::ColorRGBA c;
@@ -17,22 +19,6 @@ std_msgs::ColorRGBA colour(float r, float g, float b, float a) {
   c.b = b;
   c.a = a;
   return c;
-}
-
-/// Height colour map: blue at z <= 0 through cyan, green and yellow to red at z >= top.
-std_msgs::ColorRGBA heightColour(double z, double top) {
-  const double h = std::clamp(z / top, 0.0, 0.999) * 4.0;  // 0..4
-  const auto f = static_cast<float>(h - std::floor(h));
-  switch (static_cast<int>(h)) {
-    case 0:
-      return colour(0, f, 1, 1);
-    case 1:
-      return colour(0, 1, 1 - f, 1);
-    case 2:
-      return colour(f, 1, 0, 1);
-    default:
-      return colour(1, 1 - f, 0, 1);
-  }
 }
 
 visualization_msgs::Marker tileMarker(const mvog::TileIndex& tile, const std::string& ns,
@@ -115,7 +101,9 @@ void appendOccupiedMarkers(const mvog::Map& map, const mvog::TileIndex& tile,
     for (std::int32_t x = cells.min.x; x <= cells.max.x; ++x) {
       for (const mvog::ColumnSegment& segment : mvog::columnProfile(map.cellVolumes({x, y}))) {
         if (segment.probability <= occupancy_threshold) continue;
-        const std_msgs::ColorRGBA c = heightColour(0.5 * (segment.bottom + segment.top) * r, 3.0);
+        const mvog::Rgb rgb =
+            mvog::heightColour(0.5 * (segment.bottom + segment.top) * r / kColourMapTop);
+        const std_msgs::ColorRGBA c = colour(rgb.r, rgb.g, rgb.b, 1);
         appendBox(occupied, {x * r, y * r, segment.bottom * r},
                   {(x + 1) * r, (y + 1) * r, segment.top * r}, &c);
       }

@@ -6,17 +6,16 @@
 // unknown, trinary thresholds; a cross-section's grey levels are 255 * (1 - p).
 // Options may repeat; --threshold P (default 0.5) sets the occupancy threshold.
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "mvog/column.h"
+#include "mvog/height_colour.h"
 #include "mvog/map.h"
 #include "mvog/map_io.h"
 
@@ -24,17 +23,9 @@ namespace {
 
 constexpr std::uint8_t kUnknownGrey = 205;
 
-/// Writes `contents` to `path` through a temporary file and a rename.
+/// Writes `contents` to `path` atomically (a temporary file, fsync, rename).
 void writeAtomically(const std::string& path, const std::string& contents) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    if (!out.flush()) throw std::runtime_error("cannot write " + temporary);
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    throw std::runtime_error("cannot rename " + temporary + " to " + path);
-  }
+  mvog::writeFileAtomically(contents.data(), contents.size(), path);
 }
 
 /// Grey levels row by row from the top (+y) down, as image viewers and map_server expect.
@@ -114,21 +105,6 @@ std::string encodePng(int width, int height, const std::vector<std::uint8_t>& rg
   return png;
 }
 
-std::array<float, 3> heightColour(double t) {  // t in [0, 1]: blue, cyan, green, yellow, red
-  const double h = std::clamp(t, 0.0, 1.0) * 4.0;
-  const auto f = static_cast<float>(h - std::floor(h));
-  switch (std::min(3, static_cast<int>(h))) {
-    case 0:
-      return {0, f, 1};
-    case 1:
-      return {0, 1, 1 - f};
-    case 2:
-      return {f, 1, 0};
-    default:
-      return {1, 1 - f, 0};
-  }
-}
-
 /// Oblique orthographic view of the occupied space (p > threshold): every occupied segment is
 /// splatted as a column of cubes with a depth test, coloured by height and shaded by depth.
 void renderOccupied(const mvog::Map& map, double threshold, const std::string& path) {
@@ -179,7 +155,8 @@ void renderOccupied(const mvog::Map& map, double threshold, const std::string& p
     project(s, u, v, d);
     const int cu = 20 + static_cast<int>((u - u_min) * scale);
     const int cv = height - 20 - static_cast<int>((v - v_min) * scale);
-    const std::array<float, 3> c = heightColour((s.z - z_min) / std::max(z_max - z_min, 1e-6));
+    const mvog::Rgb colour = mvog::heightColour((s.z - z_min) / std::max(z_max - z_min, 1e-6));
+    const float c[3] = {colour.r, colour.g, colour.b};
     for (int dv = -radius; dv <= radius; ++dv) {
       for (int du = -radius; du <= radius; ++du) {
         const int px = cu + du, py = cv + dv;

@@ -12,6 +12,7 @@
 
 #include "mvog/map.h"
 #include "mvog/map_io.h"
+#include "mvog_scene/scene.h"
 
 namespace {
 
@@ -20,66 +21,24 @@ constexpr double kMaxRange = 8.0;
 const Eigen::Vector3d kRoomMin(-5.0, -4.0, 0.0);
 const Eigen::Vector3d kRoomMax(5.0, 4.0, 3.0);
 
-struct Sphere {
-  Eigen::Vector3d centre;
-  double radius;
-};
-const Sphere kSpheres[] = {{{2.0, 1.0, 0.8}, 0.6}, {{-2.5, -1.5, 1.6}, 0.9}};
-
-/// Distance from `o` (inside the room) along the unit direction `d` to the first surface.
-double castRay(const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
-  double nearest = std::numeric_limits<double>::infinity();
-  for (int axis = 0; axis < 3; ++axis) {  // the walls, floor and ceiling around `o`
-    if (d[axis] > 0.0) nearest = std::min(nearest, (kRoomMax[axis] - o[axis]) / d[axis]);
-    if (d[axis] < 0.0) nearest = std::min(nearest, (kRoomMin[axis] - o[axis]) / d[axis]);
-  }
-  for (const Sphere& sphere : kSpheres) {
-    const Eigen::Vector3d to_centre = sphere.centre - o;
-    const double along = to_centre.dot(d);
-    const double squared =
-        sphere.radius * sphere.radius - (to_centre.squaredNorm() - along * along);
-    if (squared >= 0.0 && along - std::sqrt(squared) > 0.0) {
-      nearest = std::min(nearest, along - std::sqrt(squared));
-    }
-  }
-  return nearest;
-}
-
-/// A 176 x 144 depth image (25,344 readings) from `position`, looking along `yaw`, tilted down.
-mvog::Scan depthScan(const Eigen::Vector3d& position, double yaw) {
-  constexpr int kWidth = 176;
-  constexpr int kHeight = 144;
-  const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                                    Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()))
-                                       .toRotationMatrix();
-  const double tan_x = std::tan(0.5 * 43.6 * M_PI / 180.0);
-  const double tan_y = std::tan(0.5 * 34.6 * M_PI / 180.0);
-  mvog::Scan scan;
-  scan.origin = position;
-  for (int v = 0; v < kHeight; ++v) {
-    for (int u = 0; u < kWidth; ++u) {
-      const double a = (2.0 * u / (kWidth - 1) - 1.0) * tan_x;
-      const double b = (2.0 * v / (kHeight - 1) - 1.0) * tan_y;
-      const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(1.0, -a, -b)).normalized();
-      const double range = castRay(position, direction);
-      if (range <= kMaxRange) {
-        scan.hits.push_back((position + range * direction).cast<float>());
-      } else {
-        scan.out_of_range.push_back((position + kMaxRange * direction).cast<float>());
-      }
-    }
-  }
-  return scan;
+/// The room's walls, floor and ceiling, and two spheres.
+mvog_scene::Scene roomScene() {
+  mvog_scene::Scene scene;
+  scene.boxes = mvog_scene::roomWalls(kRoomMin, kRoomMax, 0.1);
+  scene.spheres = {{{2.0, 1.0, 0.8}, 0.6}, {{-2.5, -1.5, 1.6}, 0.9}};
+  return scene;
 }
 
 /// The 12 scans of a loop through the room, each turned to look across it.
 const std::vector<mvog::Scan>& roomScans() {
   static const std::vector<mvog::Scan> scans = [] {
+    const mvog_scene::Scene scene = roomScene();
     std::vector<mvog::Scan> result;
     for (int k = 0; k < 12; ++k) {
       const double angle = 2.0 * M_PI * k / 12.0;
       const Eigen::Vector3d position(3.0 * std::cos(angle), 2.0 * std::sin(angle), 1.5);
-      result.push_back(depthScan(position, angle + M_PI / 2.0 + 0.3));
+      result.push_back(mvog_scene::depthScan(scene, mvog_scene::DepthCamera(), position,
+                                             angle + M_PI / 2.0 + 0.3, 0.3, kMaxRange));
     }
     return result;
   }();

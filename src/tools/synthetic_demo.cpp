@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <limits>
 #include <string>
 #include <vector>
 
@@ -15,18 +14,15 @@
 
 #include "mvog/map.h"
 #include "mvog/map_io.h"
+#include "mvog_scene/scene.h"
 
 namespace {
 
-struct Box {
-  Eigen::Vector3d min;
-  Eigen::Vector3d max;
-};
-
 /// The room: floor, ceiling and four walls as thin boxes, plus furniture.
-std::vector<Box> makeRoom() {
+mvog_scene::Scene makeRoom() {
   const double t = 0.1;
-  return {
+  mvog_scene::Scene room;
+  room.boxes = {
       {{-4, -3, -t}, {4, 3, 0}},      // floor
       {{-4, -3, 3}, {4, 3, 3 + t}},   // ceiling
       {{-4 - t, -3, 0}, {-4, 3, 3}},  // walls
@@ -41,54 +37,7 @@ std::vector<Box> makeRoom() {
       {{2.0, -2.0, 0}, {2.4, -1.6, 0.4}},    // boxes on the floor
       {{2.1, -1.9, 0.4}, {2.3, -1.7, 0.7}},
   };
-}
-
-/// Distance along the unit direction `d` from `o` to the nearest box, or infinity.
-double castRay(const std::vector<Box>& boxes, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
-  double nearest = std::numeric_limits<double>::infinity();
-  for (const Box& box : boxes) {
-    double t_near = 0.0;
-    double t_far = nearest;
-    for (int axis = 0; axis < 3 && t_near <= t_far; ++axis) {
-      const double inverse = 1.0 / d[axis];
-      double t0 = (box.min[axis] - o[axis]) * inverse;
-      double t1 = (box.max[axis] - o[axis]) * inverse;
-      if (t0 > t1) std::swap(t0, t1);
-      t_near = std::max(t_near, t0);
-      t_far = std::min(t_far, t1);
-    }
-    if (t_near <= t_far) nearest = t_near;
-  }
-  return nearest;
-}
-
-/// A 176 x 144 depth camera (like the paper's Swissranger 4000) at `position` looking along yaw.
-mvog::Scan depthScan(const std::vector<Box>& boxes, const Eigen::Vector3d& position, double yaw,
-                     double max_range) {
-  mvog::Scan scan;
-  scan.origin = position;
-  const Eigen::Matrix3d rotation =
-      (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(0.25, Eigen::Vector3d::UnitY()))  // tilted down a little
-          .toRotationMatrix();
-  constexpr int kWidth = 176;
-  constexpr int kHeight = 144;
-  const double half_fov_x = 0.5 * 43.6 * M_PI / 180.0;
-  const double half_fov_y = 0.5 * 34.6 * M_PI / 180.0;
-  for (int v = 0; v < kHeight; ++v) {
-    for (int u = 0; u < kWidth; ++u) {
-      const double a = (2.0 * u / (kWidth - 1) - 1.0) * std::tan(half_fov_x);
-      const double b = (2.0 * v / (kHeight - 1) - 1.0) * std::tan(half_fov_y);
-      const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(1.0, -a, -b)).normalized();
-      const double range = castRay(boxes, position, direction);
-      if (range <= max_range) {
-        scan.hits.push_back((position + range * direction).cast<float>());
-      } else {
-        scan.out_of_range.push_back((position + max_range * direction).cast<float>());
-      }
-    }
-  }
-  return scan;
+  return room;
 }
 
 }  // namespace
@@ -112,13 +61,14 @@ int main(int argc, char** argv) {
     mvog::Map map(map_config);
     mvog::InsertionConfig insertion;
     insertion.max_range = 8.0;
-    const std::vector<Box> room = makeRoom();
+    const mvog_scene::Scene room = makeRoom();
     std::vector<mvog::Scan> scans;
     for (int k = 0; k < 24; ++k) {  // a loop around the pillar, turning to see every wall
       const double angle = 2.0 * M_PI * k / 24.0;
       const Eigen::Vector3d position(2.0 * std::cos(angle), 1.6 * std::sin(angle),
                                      1.4 + 0.3 * std::sin(3 * angle));
-      scans.push_back(depthScan(room, position, angle + M_PI / 2.0 + 0.4, insertion.max_range));
+      scans.push_back(mvog_scene::depthScan(room, mvog_scene::DepthCamera(), position,
+                                            angle + M_PI / 2.0 + 0.4, 0.25, insertion.max_range));
     }
     mvog::InsertionResult result;
     const auto start = std::chrono::steady_clock::now();

@@ -1,8 +1,8 @@
-// libFuzzer target: the message conversions of the ROS layer (src/ros/conversions.h) on
+// libFuzzer target: the message conversions of the ROS layer (mvog_ros/conversions.h) on
 // LaserScan and PointCloud2 messages built from arbitrary bytes, then insertion of what they
 // yield into a map.
 //
-// Whatever the message, scanToReadings / cloudToReadings return readings or throw
+// Whatever the message, laserScanToScan / pointCloudToScan return a Scan or throw
 // InvalidMessage: no crash, no undefined behaviour, no allocation beyond what the message holds.
 // Readings that come out go into an mvog::Map, which must count every one of them exactly once.
 //
@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-#include "../../src/ros/conversions.h"
+#include "mvog_ros/conversions.h"
 
 namespace {
 
@@ -148,14 +148,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     if (is_cloud) {
       const sensor_msgs::PointCloud2 cloud = takeCloud(in);
-      readings = mvog_ros::cloudToReadings(cloud, pose, kMaxPoints);
+      readings = mvog_ros::pointCloudToScan(cloud, pose, kMaxPoints);
       message_points = std::size_t{cloud.width} * cloud.height;
       check(readings.out_of_range.empty());
       check(readings.hits.size() == message_points);
     } else {
       double max_free_range = 0.0;
       const sensor_msgs::LaserScan scan = takeScan(in, max_free_range);
-      readings = mvog_ros::scanToReadings(scan, pose, max_free_range, kMaxPoints, skipped);
+      readings = mvog_ros::laserScanToScan(scan, pose, max_free_range, kMaxPoints, skipped);
       message_points = scan.ranges.size();
       check(readings.hits.size() + readings.out_of_range.size() + skipped == message_points);
     }

@@ -4,7 +4,7 @@
 //    same map as one thread;
 //  - const methods may run concurrently with each other (many readers, no writer);
 //  - the server's pattern (src/ros/mapper.cpp): one writer (insertScan with threads, decay) under
-//    the exclusive side of its map lock (src/ros/writer_preferring_mutex.h), readers (point
+//    the exclusive side of its map lock (mvog_ros/writer_preferring_mutex.h), readers (point
 //    queries, cross-sections, projections, change tracking, serialisation, memory usage) under its
 //    shared side.
 // Map is documented as not thread-safe for a writer against readers: that is not tested.
@@ -21,9 +21,9 @@
 #include <thread>
 #include <vector>
 
-#include "../../src/ros/writer_preferring_mutex.h"
 #include "mvog/map.h"
 #include "mvog/map_io.h"
+#include "mvog_ros/writer_preferring_mutex.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// LaserScan and PointCloud2 to readings (src/ros/conversions.h): REP-117 semantics, every cloud
+// LaserScan and PointCloud2 to readings (mvog_ros/conversions.h): REP-117 semantics, every cloud
 // layout, the sensor pose, and the refusal of every malformed message.
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "../../src/ros/conversions.h"
+#include "mvog_ros/conversions.h"
 
 namespace mvog_ros {
 namespace {
@@ -49,10 +49,10 @@ sensor_msgs::LaserScan fourBeamScan(std::vector<float> ranges) {
 
 mvog::Scan convert(const sensor_msgs::LaserScan& scan, double max_free_range,
                    std::size_t& skipped) {
-  return scanToReadings(scan, Eigen::Isometry3d::Identity(), max_free_range, kManyPoints, skipped);
+  return laserScanToScan(scan, Eigen::Isometry3d::Identity(), max_free_range, kManyPoints, skipped);
 }
 
-TEST(ScanToReadings, ValidRangesAreHitsAlongTheirBeams) {
+TEST(LaserScanToScan, ValidRangesAreHitsAlongTheirBeams) {
   std::size_t skipped = 99;
   const mvog::Scan readings = convert(fourBeamScan({1.0f, 2.0f, 0.5f, 10.0f}), kInf, skipped);
   EXPECT_EQ(skipped, 0u);
@@ -64,7 +64,7 @@ TEST(ScanToReadings, ValidRangesAreHitsAlongTheirBeams) {
   expectNear(readings.hits[3], {0.0, -10.0, 0.0});  // and so is range_max
 }
 
-TEST(ScanToReadings, OutOfRangeBeamsAreFreeUpToRangeMaxOrTheMaximumFreeRange) {
+TEST(LaserScanToScan, OutOfRangeBeamsAreFreeUpToRangeMaxOrTheMaximumFreeRange) {
   std::size_t skipped = 99;
   const sensor_msgs::LaserScan scan = fourBeamScan({kInf, 12.0f, 1.0f, 5.0f});
   mvog::Scan readings = convert(scan, kInf, skipped);
@@ -82,7 +82,7 @@ TEST(ScanToReadings, OutOfRangeBeamsAreFreeUpToRangeMaxOrTheMaximumFreeRange) {
   expectNear(readings.out_of_range[1], {0.0, 4.0, 0.0});
 }
 
-TEST(ScanToReadings, NaNNegativeInfinityAndTooShortRangesAreSkippedAndCounted) {
+TEST(LaserScanToScan, NaNNegativeInfinityAndTooShortRangesAreSkippedAndCounted) {
   std::size_t skipped = 0;
   const mvog::Scan readings = convert(fourBeamScan({kNaN, -kInf, 0.4f, 3.0f}), kInf, skipped);
   EXPECT_EQ(skipped, 3u);
@@ -91,10 +91,10 @@ TEST(ScanToReadings, NaNNegativeInfinityAndTooShortRangesAreSkippedAndCounted) {
   expectNear(readings.hits[0], {0.0, -3.0, 0.0});
 }
 
-TEST(ScanToReadings, AppliesTheSensorPoseAndStartsRaysAtTheSensor) {
+TEST(LaserScanToScan, AppliesTheSensorPoseAndStartsRaysAtTheSensor) {
   std::size_t skipped = 0;
-  const mvog::Scan readings = scanToReadings(fourBeamScan({1.0f, 2.0f, kNaN, kInf}), sensorPose(),
-                                             kInf, kManyPoints, skipped);
+  const mvog::Scan readings = laserScanToScan(fourBeamScan({1.0f, 2.0f, kNaN, kInf}), sensorPose(),
+                                              kInf, kManyPoints, skipped);
   EXPECT_TRUE(readings.origin.isApprox(Eigen::Vector3d(1.0, 2.0, 3.0)));
   ASSERT_EQ(readings.hits.size(), 2u);
   expectNear(readings.hits[0], {1.0, 3.0, 3.0});   // sensor x = map y
@@ -103,7 +103,7 @@ TEST(ScanToReadings, AppliesTheSensorPoseAndStartsRaysAtTheSensor) {
   expectNear(readings.out_of_range[0], {11.0, 2.0, 3.0});  // sensor -y = map x
 }
 
-TEST(ScanToReadings, AcceptsOneBeamWithoutIncrement) {
+TEST(LaserScanToScan, AcceptsOneBeamWithoutIncrement) {
   sensor_msgs::LaserScan scan = fourBeamScan({2.0f});
   scan.angle_increment = 0.0f;
   std::size_t skipped = 0;
@@ -115,12 +115,12 @@ TEST(ScanToReadings, AcceptsOneBeamWithoutIncrement) {
 void expectRefused(const sensor_msgs::LaserScan& scan, const std::string& why,
                    std::size_t max_beams = kManyPoints) {
   std::size_t skipped = 0;
-  EXPECT_THROW(scanToReadings(scan, Eigen::Isometry3d::Identity(), kInf, max_beams, skipped),
+  EXPECT_THROW(laserScanToScan(scan, Eigen::Isometry3d::Identity(), kInf, max_beams, skipped),
                InvalidMessage)
       << why;
 }
 
-TEST(ScanToReadings, RefusesEveryMalformedScan) {
+TEST(LaserScanToScan, RefusesEveryMalformedScan) {
   const sensor_msgs::LaserScan valid = fourBeamScan({1.0f, 1.0f, 1.0f, 1.0f});
   sensor_msgs::LaserScan scan = valid;
   scan.angle_increment = 0.0f;
@@ -154,7 +154,7 @@ TEST(ScanToReadings, RefusesEveryMalformedScan) {
   expectRefused(scan, "no beams");
   expectRefused(valid, "more beams than the maximum", 3);
   std::size_t skipped = 0;
-  EXPECT_NO_THROW(scanToReadings(valid, Eigen::Isometry3d::Identity(), kInf, 4, skipped));
+  EXPECT_NO_THROW(laserScanToScan(valid, Eigen::Isometry3d::Identity(), kInf, 4, skipped));
 }
 
 // ---- PointCloud2 -----------------------------------------------------------------------------
@@ -221,18 +221,18 @@ std::vector<Eigen::Vector3d> samplePoints() {
 
 void expectPoints(const sensor_msgs::PointCloud2& cloud,
                   const std::vector<Eigen::Vector3d>& points) {
-  const mvog::Scan readings = cloudToReadings(cloud, Eigen::Isometry3d::Identity(), kManyPoints);
+  const mvog::Scan readings = pointCloudToScan(cloud, Eigen::Isometry3d::Identity(), kManyPoints);
   EXPECT_TRUE(readings.out_of_range.empty());
   ASSERT_EQ(readings.hits.size(), points.size());
   for (std::size_t k = 0; k < points.size(); ++k) expectNear(readings.hits[k], points[k]);
 }
 
-TEST(CloudToReadings, ReadsPackedFloat32Points) {
+TEST(PointCloudToScan, ReadsPackedFloat32Points) {
   const std::vector<Eigen::Vector3d> points = samplePoints();
   expectPoints(makeCloud(points, kXyzFloat32, 12, 6), points);
 }
 
-TEST(CloudToReadings, ReadsFloat64Fields) {
+TEST(PointCloudToScan, ReadsFloat64Fields) {
   const std::vector<Eigen::Vector3d> points = samplePoints();
   expectPoints(makeCloud(points,
                          {{"x", 0, sensor_msgs::PointField::FLOAT64},
@@ -242,13 +242,13 @@ TEST(CloudToReadings, ReadsFloat64Fields) {
                points);
 }
 
-TEST(CloudToReadings, ReadsOrganizedCloudsWithRowPadding) {
+TEST(PointCloudToScan, ReadsOrganizedCloudsWithRowPadding) {
   const std::vector<Eigen::Vector3d> points = samplePoints();
   expectPoints(makeCloud(points, kXyzFloat32, 12, 3, 5), points);  // 2 rows of 3, 5 spare bytes
   expectPoints(makeCloud(points, kXyzFloat32, 12, 2), points);     // 3 rows of 2
 }
 
-TEST(CloudToReadings, ReadsOddOffsetsMixedTypesAndOtherFields) {
+TEST(PointCloudToScan, ReadsOddOffsetsMixedTypesAndOtherFields) {
   // z before x, unaligned offsets, an rgb and an intensity field around them, padding at the end.
   const std::vector<Eigen::Vector3d> points = samplePoints();
   expectPoints(makeCloud(points,
@@ -261,7 +261,7 @@ TEST(CloudToReadings, ReadsOddOffsetsMixedTypesAndOtherFields) {
                points);
 }
 
-TEST(CloudToReadings, ReadsBigEndianData) {
+TEST(PointCloudToScan, ReadsBigEndianData) {
   const std::vector<Eigen::Vector3d> points = samplePoints();
   expectPoints(makeCloud(points, kXyzFloat32, 12, 6, 0, true), points);
   expectPoints(makeCloud(points,
@@ -272,11 +272,11 @@ TEST(CloudToReadings, ReadsBigEndianData) {
                points);
 }
 
-TEST(CloudToReadings, PassesNaNPointsOnForTheMapToCount) {
+TEST(PointCloudToScan, PassesNaNPointsOnForTheMapToCount) {
   const std::vector<Eigen::Vector3d> points = {
       {1.0, 2.0, 3.0}, {std::nan(""), 0.0, 0.0}, {0.0, 0.0, std::nan("")}, {4.0, 5.0, 6.0}};
   const mvog::Scan readings =
-      cloudToReadings(makeCloud(points, kXyzFloat32, 12, 2), Eigen::Isometry3d::Identity(), 10);
+      pointCloudToScan(makeCloud(points, kXyzFloat32, 12, 2), Eigen::Isometry3d::Identity(), 10);
   ASSERT_EQ(readings.hits.size(), 4u);
   expectNear(readings.hits[0], points[0]);
   EXPECT_TRUE(std::isnan(readings.hits[1].x()));
@@ -284,8 +284,8 @@ TEST(CloudToReadings, PassesNaNPointsOnForTheMapToCount) {
   expectNear(readings.hits[3], points[3]);
 }
 
-TEST(CloudToReadings, AppliesTheSensorPoseAndStartsRaysAtTheSensor) {
-  const mvog::Scan readings = cloudToReadings(
+TEST(PointCloudToScan, AppliesTheSensorPoseAndStartsRaysAtTheSensor) {
+  const mvog::Scan readings = pointCloudToScan(
       makeCloud({{1.0, 0.0, 0.0}, {0.0, 1.0, 0.5}}, kXyzFloat32, 12, 2), sensorPose(), kManyPoints);
   EXPECT_TRUE(readings.origin.isApprox(Eigen::Vector3d(1.0, 2.0, 3.0)));
   ASSERT_EQ(readings.hits.size(), 2u);
@@ -293,22 +293,22 @@ TEST(CloudToReadings, AppliesTheSensorPoseAndStartsRaysAtTheSensor) {
   expectNear(readings.hits[1], {0.0, 2.0, 3.5});
 }
 
-TEST(CloudToReadings, AcceptsAnEmptyCloud) {
+TEST(PointCloudToScan, AcceptsAnEmptyCloud) {
   sensor_msgs::PointCloud2 cloud = makeCloud({}, kXyzFloat32, 12, 1);  // height 0
-  EXPECT_TRUE(cloudToReadings(cloud, Eigen::Isometry3d::Identity(), 10).hits.empty());
+  EXPECT_TRUE(pointCloudToScan(cloud, Eigen::Isometry3d::Identity(), 10).hits.empty());
   cloud.width = 0;
   cloud.height = 5;  // rows without points, and no data
   cloud.row_step = 0;
-  EXPECT_TRUE(cloudToReadings(cloud, Eigen::Isometry3d::Identity(), 10).hits.empty());
+  EXPECT_TRUE(pointCloudToScan(cloud, Eigen::Isometry3d::Identity(), 10).hits.empty());
 }
 
 void expectRefused(const sensor_msgs::PointCloud2& cloud, const std::string& why,
                    std::size_t max_points = kManyPoints) {
-  EXPECT_THROW(cloudToReadings(cloud, Eigen::Isometry3d::Identity(), max_points), InvalidMessage)
+  EXPECT_THROW(pointCloudToScan(cloud, Eigen::Isometry3d::Identity(), max_points), InvalidMessage)
       << why;
 }
 
-TEST(CloudToReadings, RefusesEveryMalformedCloud) {
+TEST(PointCloudToScan, RefusesEveryMalformedCloud) {
   const sensor_msgs::PointCloud2 valid = makeCloud(samplePoints(), kXyzFloat32, 12, 3);
   sensor_msgs::PointCloud2 cloud = valid;
   cloud.data.pop_back();
@@ -342,7 +342,7 @@ TEST(CloudToReadings, RefusesEveryMalformedCloud) {
   expectRefused(cloud, "z beyond point_step");
   cloud = valid;
   cloud.fields[0].datatype = sensor_msgs::PointField::FLOAT64;  // x over bytes 0..7 is fine...
-  EXPECT_NO_THROW(cloudToReadings(cloud, Eigen::Isometry3d::Identity(), kManyPoints));
+  EXPECT_NO_THROW(pointCloudToScan(cloud, Eigen::Isometry3d::Identity(), kManyPoints));
   cloud.fields[0].offset = 5;  // ...but not over 5..12
   expectRefused(cloud, "float64 x beyond point_step");
   cloud = valid;
@@ -358,7 +358,7 @@ TEST(CloudToReadings, RefusesEveryMalformedCloud) {
   cloud.row_step = 12u << 20;
   expectRefused(cloud, "2^40 points with short data", std::size_t{1} << 41);
   expectRefused(valid, "more points than the maximum", 5);
-  EXPECT_NO_THROW(cloudToReadings(valid, Eigen::Isometry3d::Identity(), 6));
+  EXPECT_NO_THROW(pointCloudToScan(valid, Eigen::Isometry3d::Identity(), 6));
 }
 
 // ---- Voxel filter ----------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-// Service path resolution (src/ros/map_paths.h): everything a save or load may touch stays inside
+// Service path resolution (mvog_ros/map_paths.h): everything a save or load may touch stays inside
 // ~map_directory, whatever ".." or symlinks the request holds.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -9,7 +9,7 @@
 #include <fstream>
 #include <string>
 
-#include "../../src/ros/map_paths.h"
+#include "mvog_ros/map_paths.h"
 
 namespace mvog_ros {
 namespace {

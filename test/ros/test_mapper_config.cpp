@@ -1,4 +1,4 @@
-// MapperConfig::validate (src/ros/mapper_config.h): every invalid parameter is refused with a
+// MapperConfig::validate (mvog_ros/mapper_config.h): every invalid parameter is refused with a
 // message naming it. (fromParameters needs a master: the rostests cover it.)
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "../../src/ros/mapper_config.h"
+#include "mvog_ros/mapper_config.h"
 
 namespace mvog_ros {
 namespace {
@@ -18,7 +18,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 MapperConfig validConfig() {
   MapperConfig config;
-  config.map_directory = "/tmp/mvog_maps";  // fromParameters sets the default
+  config.map_files.map_directory = "/tmp/mvog_maps";  // fromParameters sets the default
   return config;
 }
 
@@ -54,22 +54,23 @@ TEST(MapperConfig, AcceptsSensibleNonDefaultValues) {
   config.insertion.min_range = 0.3;
   config.insertion.max_range = 8.0;
   config.insertion.insertion_threads = 4;
-  config.scan_topics = {"front/scan", "/rear/scan", "~scan"};
-  config.cloud_topics = {"camera/depth/points"};
-  config.tf_timeout = 0.0;
-  config.voxel_filter_size = 0.05;
-  config.decay_factor = 0.9;
-  config.decay_period = 1.0;
+  config.inputs.scan_topics = {"front/scan", "/rear/scan", "~scan"};
+  config.inputs.cloud_topics = {"camera/depth/points"};
+  config.queries.tf_timeout = 0.0;
+  config.inputs.voxel_filter_size = 0.05;
+  config.decay.decay_factor = 0.9;
+  config.decay.decay_period = 1.0;
   config.occupancy_threshold = 0.0;
-  config.cross_section_heights = {-1.0, 0.5, 1.5};
-  config.projection_min_z = 0.1;
-  config.projection_max_z = 2.0;
-  config.binary_map_period = 0.0;
-  config.autosave_period = 60.0;
-  config.max_query_points = 1;
+  config.publications.cross_section_heights = {-1.0, 0.5, 1.5};
+  config.publications.projection_min_z = 0.1;
+  config.publications.projection_max_z = 2.0;
+  config.publications.binary_map_period = 0.0;
+  config.map_files.autosave_period = 60.0;
+  config.queries.max_query_points = 1;
   config.max_cross_section_cells = 1 << 28;
   EXPECT_EQ(refusal(config), "");
-  config.projection_min_z = config.projection_max_z = 1.0;  // a single height
+  config.publications.projection_min_z = config.publications.projection_max_z =
+      1.0;  // a single height
   EXPECT_EQ(refusal(config), "");
 }
 
@@ -101,21 +102,26 @@ TEST(MapperConfig, RefusesNaNInfiniteNegativeOrZeroNumbers) {
   add(
       "min_range", [](MapperConfig& c) -> double& { return c.insertion.min_range; }, true);
   add(
-      "tf_timeout", [](MapperConfig& c) -> double& { return c.tf_timeout; }, true);
+      "tf_timeout", [](MapperConfig& c) -> double& { return c.queries.tf_timeout; }, true);
   add(
-      "voxel_filter_size", [](MapperConfig& c) -> double& { return c.voxel_filter_size; }, true);
+      "voxel_filter_size", [](MapperConfig& c) -> double& { return c.inputs.voxel_filter_size; },
+      true);
   add(
-      "decay_factor", [](MapperConfig& c) -> double& { return c.decay_factor; }, false);
+      "decay_factor", [](MapperConfig& c) -> double& { return c.decay.decay_factor; }, false);
   add(
-      "decay_period", [](MapperConfig& c) -> double& { return c.decay_period; }, true);
+      "decay_period", [](MapperConfig& c) -> double& { return c.decay.decay_period; }, true);
   add(
-      "publish_period", [](MapperConfig& c) -> double& { return c.publish_period; }, false);
+      "publish_period", [](MapperConfig& c) -> double& { return c.publications.publish_period; },
+      false);
   add(
-      "binary_map_period", [](MapperConfig& c) -> double& { return c.binary_map_period; }, true);
+      "binary_map_period",
+      [](MapperConfig& c) -> double& { return c.publications.binary_map_period; }, true);
   add(
-      "statistics_period", [](MapperConfig& c) -> double& { return c.statistics_period; }, false);
+      "statistics_period",
+      [](MapperConfig& c) -> double& { return c.publications.statistics_period; }, false);
   add(
-      "autosave_period", [](MapperConfig& c) -> double& { return c.autosave_period; }, true);
+      "autosave_period", [](MapperConfig& c) -> double& { return c.map_files.autosave_period; },
+      true);
   for (const InvalidCase& invalid : cases) expectRefused(invalid);
 }
 
@@ -132,34 +138,39 @@ TEST(MapperConfig, RefusesOutOfRangeValues) {
       {"insertion_threads", "0", [](MapperConfig& c) { c.insertion.insertion_threads = 0; }},
       {"insertion_threads", "< 0", [](MapperConfig& c) { c.insertion.insertion_threads = -2; }},
       {"insertion_threads", "1000", [](MapperConfig& c) { c.insertion.insertion_threads = 1000; }},
-      {"sensor_queue_size", "0", [](MapperConfig& c) { c.sensor_queue_size = 0; }},
-      {"sensor_queue_size", "< 0", [](MapperConfig& c) { c.sensor_queue_size = -1; }},
-      {"sensor_queue_size", "huge", [](MapperConfig& c) { c.sensor_queue_size = 1 << 30; }},
-      {"insertion_queue_size", "0", [](MapperConfig& c) { c.insertion_queue_size = 0; }},
-      {"insertion_queue_size", "< 0", [](MapperConfig& c) { c.insertion_queue_size = -1; }},
-      {"insertion_queue_size", "huge", [](MapperConfig& c) { c.insertion_queue_size = 1 << 30; }},
-      {"max_points_per_message", "0", [](MapperConfig& c) { c.max_points_per_message = 0; }},
-      {"max_points_per_message", "< 0", [](MapperConfig& c) { c.max_points_per_message = -1; }},
-      {"decay_factor", "> 1", [](MapperConfig& c) { c.decay_factor = 1.5; }},
+      {"sensor_queue_size", "0", [](MapperConfig& c) { c.inputs.sensor_queue_size = 0; }},
+      {"sensor_queue_size", "< 0", [](MapperConfig& c) { c.inputs.sensor_queue_size = -1; }},
+      {"sensor_queue_size", "huge", [](MapperConfig& c) { c.inputs.sensor_queue_size = 1 << 30; }},
+      {"insertion_queue_size", "0", [](MapperConfig& c) { c.insertion.insertion_queue_size = 0; }},
+      {"insertion_queue_size", "< 0",
+       [](MapperConfig& c) { c.insertion.insertion_queue_size = -1; }},
+      {"insertion_queue_size", "huge",
+       [](MapperConfig& c) { c.insertion.insertion_queue_size = 1 << 30; }},
+      {"max_points_per_message", "0", [](MapperConfig& c) { c.inputs.max_points_per_message = 0; }},
+      {"max_points_per_message", "< 0",
+       [](MapperConfig& c) { c.inputs.max_points_per_message = -1; }},
+      {"decay_factor", "> 1", [](MapperConfig& c) { c.decay.decay_factor = 1.5; }},
       {"occupancy_threshold", "NaN", [](MapperConfig& c) { c.occupancy_threshold = kNaN; }},
       {"occupancy_threshold", "< 0", [](MapperConfig& c) { c.occupancy_threshold = -0.1; }},
       {"occupancy_threshold", "1", [](MapperConfig& c) { c.occupancy_threshold = 1.0; }},
       {"occupancy_threshold", "> 1", [](MapperConfig& c) { c.occupancy_threshold = 2.0; }},
-      {"max_query_points", "0", [](MapperConfig& c) { c.max_query_points = 0; }},
-      {"max_query_points", "< 0", [](MapperConfig& c) { c.max_query_points = -1; }},
+      {"max_query_points", "0", [](MapperConfig& c) { c.queries.max_query_points = 0; }},
+      {"max_query_points", "< 0", [](MapperConfig& c) { c.queries.max_query_points = -1; }},
       {"max_cross_section_cells", "0", [](MapperConfig& c) { c.max_cross_section_cells = 0; }},
       {"max_cross_section_cells", "< 0", [](MapperConfig& c) { c.max_cross_section_cells = -1; }},
       {"max_cross_section_cells", "beyond the core's 2^28",
        [](MapperConfig& c) { c.max_cross_section_cells = (1 << 28) + 1; }},
-      {"publish_period", "beyond ros::Duration", [](MapperConfig& c) { c.publish_period = 3e9; }},
+      {"publish_period", "beyond ros::Duration",
+       [](MapperConfig& c) { c.publications.publish_period = 3e9; }},
       {"statistics_period", "beyond ros::Duration",
-       [](MapperConfig& c) { c.statistics_period = 1e300; }},
-      {"tf_timeout", "beyond ros::Duration", [](MapperConfig& c) { c.tf_timeout = 1e10; }},
-      {"decay_period", "beyond ros::Duration", [](MapperConfig& c) { c.decay_period = 1e10; }},
+       [](MapperConfig& c) { c.publications.statistics_period = 1e300; }},
+      {"tf_timeout", "beyond ros::Duration", [](MapperConfig& c) { c.queries.tf_timeout = 1e10; }},
+      {"decay_period", "beyond ros::Duration",
+       [](MapperConfig& c) { c.decay.decay_period = 1e10; }},
       {"binary_map_period", "beyond ros::Duration",
-       [](MapperConfig& c) { c.binary_map_period = 1e10; }},
+       [](MapperConfig& c) { c.publications.binary_map_period = 1e10; }},
       {"autosave_period", "beyond ros::Duration",
-       [](MapperConfig& c) { c.autosave_period = 1e10; }},
+       [](MapperConfig& c) { c.map_files.autosave_period = 1e10; }},
   };
   for (const InvalidCase& invalid : cases) expectRefused(invalid);
 }
@@ -175,27 +186,30 @@ TEST(MapperConfig, RefusesContradictoryValues) {
        }},
       {"projection_min_z", "> projection_max_z",
        [](MapperConfig& c) {
-         c.projection_min_z = 2.0;
-         c.projection_max_z = 1.0;
+         c.publications.projection_min_z = 2.0;
+         c.publications.projection_max_z = 1.0;
        }},
-      {"projection_min_z", "NaN", [](MapperConfig& c) { c.projection_min_z = kNaN; }},
-      {"projection_max_z", "NaN", [](MapperConfig& c) { c.projection_max_z = kNaN; }},
+      {"projection_min_z", "NaN", [](MapperConfig& c) { c.publications.projection_min_z = kNaN; }},
+      {"projection_max_z", "NaN", [](MapperConfig& c) { c.publications.projection_max_z = kNaN; }},
       {"projection_min_z", "above a max of -Inf",
        [](MapperConfig& c) {
-         c.projection_min_z = 0.0;
-         c.projection_max_z = -kInf;
+         c.publications.projection_min_z = 0.0;
+         c.publications.projection_max_z = -kInf;
        }},
       {"cross_section_heights", "NaN",
        [](MapperConfig& c) {
-         c.cross_section_heights = {0.5, kNaN};
+         c.publications.cross_section_heights = {0.5, kNaN};
        }},
-      {"cross_section_heights", "Inf", [](MapperConfig& c) { c.cross_section_heights = {kInf}; }},
+      {"cross_section_heights", "Inf",
+       [](MapperConfig& c) { c.publications.cross_section_heights = {kInf}; }},
       {"cross_section_heights", "beyond max_coordinate",
-       [](MapperConfig& c) { c.cross_section_heights = {c.map.max_coordinate + 1.0}; }},
+       [](MapperConfig& c) {
+         c.publications.cross_section_heights = {c.map.max_coordinate + 1.0};
+       }},
       {"autosave_file", "empty while autosaving",
        [](MapperConfig& c) {
-         c.autosave_period = 10.0;
-         c.autosave_file.clear();
+         c.map_files.autosave_period = 10.0;
+         c.map_files.autosave_file.clear();
        }},
   };
   for (const InvalidCase& invalid : cases) expectRefused(invalid);
@@ -205,21 +219,23 @@ TEST(MapperConfig, RefusesEmptyOrInvalidNames) {
   const std::vector<InvalidCase> cases = {
       {"frame_id", "empty", [](MapperConfig& c) { c.frame_id.clear(); }},
       {"frame_id", "with a leading slash", [](MapperConfig& c) { c.frame_id = "/map"; }},
-      {"map_directory", "empty", [](MapperConfig& c) { c.map_directory.clear(); }},
+      {"map_directory", "empty", [](MapperConfig& c) { c.map_files.map_directory.clear(); }},
       {"scan_topics", "an empty topic",
        [](MapperConfig& c) {
-         c.scan_topics = {"scan2", ""};
+         c.inputs.scan_topics = {"scan2", ""};
        }},
-      {"scan_topics", "an invalid topic", [](MapperConfig& c) { c.scan_topics = {"bad topic"}; }},
-      {"cloud_topics", "an empty topic", [](MapperConfig& c) { c.cloud_topics = {""}; }},
-      {"cloud_topics", "an invalid topic", [](MapperConfig& c) { c.cloud_topics = {"3d/pts"}; }},
+      {"scan_topics", "an invalid topic",
+       [](MapperConfig& c) { c.inputs.scan_topics = {"bad topic"}; }},
+      {"cloud_topics", "an empty topic", [](MapperConfig& c) { c.inputs.cloud_topics = {""}; }},
+      {"cloud_topics", "an invalid topic",
+       [](MapperConfig& c) { c.inputs.cloud_topics = {"3d/pts"}; }},
   };
   for (const InvalidCase& invalid : cases) expectRefused(invalid);
 }
 
 TEST(MapperConfig, AnEmptyAutosaveFileIsFineWhileAutosaveIsOff) {
   MapperConfig config = validConfig();
-  config.autosave_file.clear();
+  config.map_files.autosave_file.clear();
   EXPECT_EQ(refusal(config), "");
 }
 

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <nodelet/NodeletList.h>
@@ -51,6 +52,7 @@
 #include "mvog/MapFile.h"
 #include "mvog/MapStatistics.h"
 #include "mvog/map_io.h"
+#include "mvog_scene/scene.h"
 
 namespace {
 
@@ -75,37 +77,10 @@ bool waitFor(const std::function<bool()>& condition, double timeout = kTimeout) 
 
 // ---- The scene -------------------------------------------------------------------------------
 
-/// An obstacle of infinite height over an axis-aligned rectangle (m).
-struct Box {
-  double min_x, min_y, max_x, max_y;
-};
-const Box kWall{3.05, -2.5, 3.25, 2.5};
-const Box kPerson{1.45, -0.1, 1.65, 0.1};  // stands in the decay test's beams
-
-/// Distance along a horizontal ray (unit `direction`) to the nearest box, or +Inf.
-double castRay(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
-               const std::vector<Box>& boxes) {
-  double nearest = std::numeric_limits<double>::infinity();
-  for (const Box& box : boxes) {
-    double enter = 0.0;
-    double leave = std::numeric_limits<double>::infinity();
-    const double low[2] = {box.min_x, box.min_y};
-    const double high[2] = {box.max_x, box.max_y};
-    for (int axis = 0; axis < 2; ++axis) {
-      if (std::fabs(direction[axis]) < 1e-12) {
-        if (origin[axis] < low[axis] || origin[axis] > high[axis]) leave = -1.0;
-        continue;
-      }
-      double t0 = (low[axis] - origin[axis]) / direction[axis];
-      double t1 = (high[axis] - origin[axis]) / direction[axis];
-      if (t0 > t1) std::swap(t0, t1);
-      enter = std::max(enter, t0);
-      leave = std::min(leave, t1);
-    }
-    if (enter <= leave) nearest = std::min(nearest, enter);
-  }
-  return nearest;
-}
+constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Obstacles of infinite height over an axis-aligned rectangle (m).
+const mvog_scene::Box kWall{{3.05, -2.5, -kInf}, {3.25, 2.5, kInf}};
+const mvog_scene::Box kPerson{{1.45, -0.1, -kInf}, {1.65, 0.1, kInf}};  // in the decay beams
 
 Eigen::Isometry3d mapFromBase(double y) {
   return Eigen::Isometry3d(Eigen::Translation3d(0.0, y, 0.0));
@@ -143,9 +118,9 @@ const ScanLayout kDecayLaser{-0.6, 0.6, 0.01};
 /// Beams 0..2 of every moving-laser scan say nothing: NaN, -Inf, below range_min.
 constexpr std::size_t kSkippedBeamsPerScan = 3;
 
-/// A horizontal LaserScan of the boxes by a laser at `map_from_laser` (turned about z only).
+/// A horizontal LaserScan of the scene by a laser at `map_from_laser` (turned about z only).
 sensor_msgs::LaserScan scanOf(const Eigen::Isometry3d& map_from_laser, const ScanLayout& layout,
-                              const std::vector<Box>& boxes, const std::string& frame,
+                              const mvog_scene::Scene& scene, const std::string& frame,
                               const ros::Time& stamp) {
   sensor_msgs::LaserScan scan;
   scan.header.frame_id = frame;
@@ -155,12 +130,11 @@ sensor_msgs::LaserScan scanOf(const Eigen::Isometry3d& map_from_laser, const Sca
   scan.angle_increment = static_cast<float>(layout.angle_increment);
   scan.range_min = kLaserRangeMin;
   scan.range_max = kLaserRangeMax;
-  const Eigen::Vector2d origin = map_from_laser.translation().head<2>();
   for (std::size_t k = 0; k < layout.beams(); ++k) {
     const double angle = scan.angle_min + static_cast<double>(k) * scan.angle_increment;
     const Eigen::Vector3d direction =
         map_from_laser.linear() * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
-    const double range = castRay(origin, direction.head<2>().normalized(), boxes);
+    const double range = scene.castRay(map_from_laser.translation(), direction.normalized());
     scan.ranges.push_back(range <= kLaserRangeMax ? static_cast<float>(range)
                                                   : std::numeric_limits<float>::infinity());
   }
@@ -447,17 +421,17 @@ class SceneSensors {
   /// A scan of the moving laser with its base at y, with three beams that say nothing.
   static sensor_msgs::LaserScan movingScan(double base_y, const ros::Time& stamp) {
     sensor_msgs::LaserScan scan =
-        scanOf(mapFromBase(base_y) * kBaseFromLaser, kMovingLaser, {kWall}, "laser", stamp);
+        scanOf(mapFromBase(base_y) * kBaseFromLaser, kMovingLaser, {{kWall}, {}}, "laser", stamp);
     scan.ranges[0] = std::numeric_limits<float>::quiet_NaN();
     scan.ranges[1] = -std::numeric_limits<float>::infinity();
     scan.ranges[2] = kLaserRangeMin / 2.0f;
     return scan;
   }
   void publishDecayScan(const std::vector<std::string>& topics, bool with_person) {
-    std::vector<Box> boxes{kWall};
-    if (with_person) boxes.push_back(kPerson);
+    mvog_scene::Scene scene{{kWall}, {}};
+    if (with_person) scene.boxes.push_back(kPerson);
     const sensor_msgs::LaserScan scan =
-        scanOf(kMapFromDecayLaser, kDecayLaser, boxes, "decay_laser", ros::Time::now());
+        scanOf(kMapFromDecayLaser, kDecayLaser, scene, "decay_laser", ros::Time::now());
     for (const std::string& topic : topics) publisher<sensor_msgs::LaserScan>(topic).publish(scan);
   }
   void publishWallCloud(const std::string& topic) {
@@ -577,7 +551,7 @@ TEST_F(Mapper, CountsReadingsAndDroppedMessages) {
   mapScene();
   // Malformed messages are dropped and counted, and change nothing.
   sensor_msgs::LaserScan bad_scan =
-      scanOf(kMapFromDecayLaser, kDecayLaser, {kWall}, "decay_laser", ros::Time::now());
+      scanOf(kMapFromDecayLaser, kDecayLaser, {{kWall}, {}}, "decay_laser", ros::Time::now());
   bad_scan.angle_increment = std::numeric_limits<float>::quiet_NaN();
   sensors_->publisher<sensor_msgs::LaserScan>("/scan").publish(bad_scan);
   sensor_msgs::PointCloud2 bad_cloud = wallCloud(ros::Time::now());
@@ -604,6 +578,32 @@ TEST_F(Mapper, CountsReadingsAndDroppedMessages) {
   EXPECT_DOUBLE_EQ(statistics.resolution, kResolution);
   EXPECT_EQ(statistics.header.frame_id, "map");
   expectSceneAnswers();
+}
+
+/// The value of `key` in the status `name` of a /diagnostics message, or "" if it is not there.
+std::string diagnosticValue(const diagnostic_msgs::DiagnosticArray& array, const std::string& name,
+                            const std::string& key) {
+  for (const diagnostic_msgs::DiagnosticStatus& status : array.status) {
+    if (status.name != name) continue;
+    for (const diagnostic_msgs::KeyValue& value : status.values) {
+      if (value.key == key) return value.value;
+    }
+  }
+  return "";
+}
+
+TEST_F(Mapper, ReportsItsStatisticsOnDiagnostics) {
+  ros::NodeHandle nh;
+  Inbox<diagnostic_msgs::DiagnosticArray> diagnostics(nh, "/diagnostics");
+  mapScene();
+  const std::string status = server_->name().substr(1) + ": mapping";  // the node's name
+  const std::string inserted = std::to_string(kScans + kClouds);
+  EXPECT_TRUE(diagnostics.waitForMessage([&](const diagnostic_msgs::DiagnosticArray& array) {
+    return diagnosticValue(array, status, "messages_inserted") == inserted &&
+           diagnosticValue(array, status, "messages_dropped_queue") == "0" &&
+           diagnosticValue(array, status, "frame_id") == "map";
+  })) << "no status '"
+      << status << "' with " << inserted << " messages inserted";
 }
 
 TEST_F(Mapper, TransformsQueriesGivenInAnotherFrame) {
@@ -667,7 +667,7 @@ TEST_F(Mapper, WaitsForTransformsThatComeLate) {
   server_->waitForInsertedMessages(1);
   // A tf1-style frame id with a leading slash is fine; a message without frame id is dropped.
   sensor_msgs::LaserScan scan =
-      scanOf(kMapFromDecayLaser, kDecayLaser, {kWall}, "/decay_laser", ros::Time::now());
+      scanOf(kMapFromDecayLaser, kDecayLaser, {{kWall}, {}}, "/decay_laser", ros::Time::now());
   sensors_->publisher<sensor_msgs::LaserScan>("/scan").publish(scan);
   scan.header.frame_id.clear();
   sensors_->publisher<sensor_msgs::LaserScan>("/scan").publish(scan);

@@ -1,4 +1,4 @@
-// The map's lock in the server (src/ros/writer_preferring_mutex.h): readers share it, a writer
+// The map's lock in the server (mvog_ros/writer_preferring_mutex.h): readers share it, a writer
 // excludes everyone, and a waiting writer goes before new readers, so that queries arriving
 // without a pause cannot keep insertion out.
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <shared_mutex>
 #include <thread>
 
-#include "../../src/ros/writer_preferring_mutex.h"
+#include "mvog_ros/writer_preferring_mutex.h"
 
 namespace {
 

@@ -13,8 +13,8 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "conversions.h"
 #include "input.h"
+#include "mvog_ros/conversions.h"
 
 namespace mvog_bench {
 namespace {
@@ -73,12 +73,12 @@ InputData loadBag(const std::string& path, const std::string& fixed_frame) {
       try {
         if (is_scan) {
           std::size_t skipped = 0;
-          readings = mvog_ros::scanToReadings(*scan, map_from_sensor,
-                                              std::numeric_limits<double>::infinity(), kNoSizeLimit,
-                                              skipped);
+          readings = mvog_ros::laserScanToScan(*scan, map_from_sensor,
+                                               std::numeric_limits<double>::infinity(),
+                                               kNoSizeLimit, skipped);
           input.skipped_beams += skipped;
         } else {
-          readings = mvog_ros::cloudToReadings(*cloud, map_from_sensor, kNoSizeLimit);
+          readings = mvog_ros::pointCloudToScan(*cloud, map_from_sensor, kNoSizeLimit);
         }
       } catch (const mvog_ros::InvalidMessage&) {
         ++input.invalid_messages;

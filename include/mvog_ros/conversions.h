@@ -1,0 +1,44 @@
+#pragma once
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+#include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <Eigen/Geometry>
+
+#include "mvog/map.h"
+
+namespace mvog_ros {
+
+/// A sensor message that cannot be turned into readings; the message says why.
+class InvalidMessage : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A LaserScan as an mvog::Scan: its readings in the map frame given the sensor's pose
+/// `map_from_sensor` at the scan's stamp (the pose is taken as constant over the sweep), from the
+/// sensor frame's origin. REP-117: a finite range within [range_min, range_max] is an obstacle
+/// reading; +Inf and ranges above range_max are out-of-range readings, free up to
+/// min(range_max, max_free_range); NaN, -Inf and ranges below range_min say nothing about free
+/// space (an object may be too close) and are skipped.
+/// Throws InvalidMessage for a malformed scan (bad angles, range limits, or beam count).
+mvog::Scan laserScanToScan(const sensor_msgs::LaserScan& scan,
+                           const Eigen::Isometry3d& map_from_sensor, double max_free_range,
+                           std::size_t max_beams, std::size_t& skipped_beams);
+
+/// A PointCloud2 as an mvog::Scan: the points of a cloud of any layout (float32 or float64 x, y, z
+/// at any offsets, organized or not, either byte order) as obstacle readings in the map frame,
+/// from the sensor frame's origin. Non-finite points are passed on for the map to count and reject.
+/// Throws InvalidMessage for a malformed cloud (missing or integer x/y/z fields, fields beyond
+/// point_step, data shorter than its dimensions, more than max_points points).
+mvog::Scan pointCloudToScan(const sensor_msgs::PointCloud2& cloud,
+                            const Eigen::Isometry3d& map_from_sensor, std::size_t max_points);
+
+/// Keeps one point per voxel of edge `leaf_size` (the centroid of its points), with PCL.
+/// Non-finite points are dropped: returns how many.
+std::size_t voxelFilter(std::vector<Eigen::Vector3f>& points, double leaf_size);
+
+}  // namespace mvog_ros

@@ -1,0 +1,31 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mvog_ros/inputs/sensor_input.h"
+
+namespace mvog_ros {
+
+/// The server's sensor inputs: a LaserScanInput for `scan` and each of ~scan_topics, a
+/// PointCloudInput for `cloud_in` and each of ~cloud_topics (topics relative to `nh`), and the
+/// counts of what they dropped.
+class SensorInputs {
+ public:
+  /// `max_range`: ~max_range, where LaserScan out-of-range readings end at the latest.
+  SensorInputs(ros::NodeHandle nh, const SensorInputsConfig& config, const std::string& frame_id,
+               double max_range, const tf2_ros::Buffer& tf_buffer, EnqueueScan enqueue);
+
+  /// Every input stops taking messages (SensorInput::stop).
+  void stop();
+
+  InputStatistics statistics() const { return counters_.statistics(); }
+  void resetStatistics() { counters_.reset(); }
+
+ private:
+  InputCounters counters_;
+  std::vector<std::unique_ptr<SensorInput>> inputs_;
+};
+
+}  // namespace mvog_ros

@@ -1,0 +1,82 @@
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "mvog/map.h"
+#include "mvog/scan_update.h"
+#include "mvog_ros/mapper_config.h"
+#include "mvog_ros/shared_map.h"
+
+namespace mvog_ros {
+
+/// What the insertion worker did since the start or the last reset.
+struct InsertionStatistics {
+  std::uint64_t messages_inserted = 0;
+  std::uint64_t messages_dropped_queue = 0;  // the oldest waiting, when the queue was full
+  std::uint64_t readings_inserted = 0;
+  std::uint64_t readings_rejected = 0;  // by the core: mvog::InsertionResult::rejected()
+  double insertion_seconds = 0.0;
+  std::uint64_t out_of_range_readings = 0;
+  /// Thread time rasterising the obstacle readings and the out-of-range readings.
+  double obstacle_seconds = 0.0;
+  double out_of_range_seconds = 0.0;
+};
+
+/// Inserts converted sensor messages into the map, on a thread of its own behind a bounded queue
+/// (~insertion_queue_size): when the sensors outpace it, the oldest waiting message is dropped
+/// and counted, so that the newest view is kept. The only writer of readings into the map.
+class InsertionWorker {
+ public:
+  InsertionWorker(const InsertionWorkerConfig& config, SharedMap& shared_map);
+  /// stop()
+  ~InsertionWorker();
+  InsertionWorker(const InsertionWorker&) = delete;
+  InsertionWorker& operator=(const InsertionWorker&) = delete;
+
+  /// Queues `scan` for insertion; `source` (its message type) names it in warnings.
+  void enqueue(mvog::Scan&& scan, const std::string& source);
+  /// Inserts what is queued, then ends the thread: nothing enqueued afterwards is inserted.
+  void stop();
+
+  InsertionStatistics statistics() const;
+  void resetStatistics();
+
+ private:
+  struct QueuedScan {
+    mvog::Scan scan;
+    std::string source;
+  };
+
+  void run();
+  /// The worker's one call into the core: `scan` into the map, prepared outside the map's lock
+  /// and applied under its write lock.
+  mvog::InsertionResult insert(const mvog::Scan& scan);
+
+  const InsertionWorkerConfig config_;
+  SharedMap& map_;
+  mvog::ScanUpdate update_;  // its buffers and threads, kept from scan to scan
+
+  std::mutex queue_mutex_;
+  std::condition_variable queue_changed_;
+  std::deque<QueuedScan> queue_;
+  bool stopping_ = false;
+
+  std::atomic<std::uint64_t> messages_inserted_{0};
+  std::atomic<std::uint64_t> messages_dropped_queue_{0};
+  std::atomic<std::uint64_t> readings_inserted_{0};
+  std::atomic<std::uint64_t> readings_rejected_{0};
+  std::atomic<std::uint64_t> insertion_nanoseconds_{0};
+  std::atomic<std::uint64_t> out_of_range_readings_{0};
+  std::atomic<std::uint64_t> obstacle_nanoseconds_{0};
+  std::atomic<std::uint64_t> out_of_range_nanoseconds_{0};
+
+  std::thread thread_;  // last: it runs on the members above
+};
+
+}  // namespace mvog_ros

@@ -1,0 +1,63 @@
+#pragma once
+
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "mvog/map.h"
+#include "mvog_ros/inputs/sensor_inputs.h"
+#include "mvog_ros/insertion_worker.h"
+#include "mvog_ros/mapper_config.h"
+#include "mvog_ros/publications/binary_map_publication.h"
+#include "mvog_ros/publications/grid_publication.h"
+#include "mvog_ros/publications/marker_publication.h"
+#include "mvog_ros/publications/statistics_publication.h"
+#include "mvog_ros/services/map_file_services.h"
+#include "mvog_ros/services/query_services.h"
+#include "mvog_ros/services/reset_service.h"
+#include "mvog_ros/shared_map.h"
+
+namespace mvog_ros {
+
+/// The mapping server, shared by the nodelet and the node. It owns the map and its lock
+/// (SharedMap) and composes the parts that use them, each with its slice of MapperConfig:
+///   sensor inputs      subscribe, wait for tf, convert (SensorInputs: inputs/)
+///   insertion worker   bounded queue and thread, the only writer of readings (InsertionWorker)
+///   publications       markers, grids, binary map, statistics (publications/)
+///   services           queries, map files and autosave, reset (services/)
+/// and decays the map itself. Callbacks may run on several threads at once.
+class Mapper {
+ public:
+  /// Throws mvog::ConfigError naming the parameter at fault (~map_file if it cannot be loaded).
+  Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  /// Stops the inputs, inserts what is queued, and autosaves once more (with autosave on).
+  ~Mapper();
+  Mapper(const Mapper&) = delete;
+  Mapper& operator=(const Mapper&) = delete;
+
+ private:
+  /// Puts `map` in place of the server's (~load_map, ~reset); the publications clear what they
+  /// showed of the previous one at once.
+  void replaceMap(mvog::Map&& map);
+  void decay(const ros::TimerEvent&);
+
+  const MapperConfig config_;
+  SharedMap map_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+
+  // The parts, in the order they start. The inputs come once everything they feed exists, the
+  // reset service and the statistics once the counts they use do; they end in reverse order.
+  InsertionWorker insertion_;
+  MarkerPublication markers_;
+  GridPublication grids_;
+  BinaryMapPublication binary_map_;
+  QueryServices queries_;
+  MapFileServices map_files_;
+  ros::Timer decay_timer_;
+  SensorInputs inputs_;
+  ResetService reset_;
+  StatisticsPublication statistics_;
+};
+
+}  // namespace mvog_ros

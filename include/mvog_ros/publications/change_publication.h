@@ -1,0 +1,53 @@
+#pragma once
+
+#include <mutex>
+#include <vector>
+
+#include <ros/ros.h>
+
+#include "mvog/map.h"
+#include "mvog_ros/shared_map.h"
+
+namespace mvog_ros {
+
+/// What MarkerPublication and GridPublication share: every ~publish_period they publish what
+/// changed in the map since they last did (the tiles modified since), and once the map was
+/// replaced (~load_map, ~reset) they first clear what they showed of the previous one. Their
+/// connection callbacks take the same lock (mutex_, then the map's) to send a new subscriber
+/// everything.
+class ChangePublication {
+ public:
+  virtual ~ChangePublication();
+  ChangePublication(const ChangePublication&) = delete;
+  ChangePublication& operator=(const ChangePublication&) = delete;
+
+  /// Once the map was replaced, clears what was published of the previous map. Called by Mapper
+  /// right after a replacement; the next publication would do it anyway.
+  void restartIfReplaced();
+
+ protected:
+  explicit ChangePublication(const SharedMap& shared_map);
+  /// Starts publishing every `period` s: the last step of a derived constructor.
+  void start(ros::NodeHandle& private_nh, double period);
+  /// Stops publishing: the first step of a derived destructor (the timer calls the derived
+  /// class).
+  void stop();
+  /// Under mutex_ and the map's lock.
+  void restartIfReplacedLocked();
+
+  /// Clears what was published of the previous map (under mutex_ and the map's lock).
+  virtual void clearPublished() = 0;
+  /// Publishes the tiles changed (under mutex_ and the map's lock).
+  virtual void publishTiles(const std::vector<mvog::TileIndex>& changed) = 0;
+
+  const SharedMap& map_;
+  std::mutex mutex_;      // published_, the derived class's state, one publication at a time
+  MapVersion published_;  // what the publication shows
+
+ private:
+  void publishChanges(const ros::TimerEvent&);
+
+  ros::Timer timer_;
+};
+
+}  // namespace mvog_ros

@@ -1,0 +1,51 @@
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <ros/ros.h>
+
+#include "mvog_ros/mapper_config.h"
+#include "mvog_ros/publications/change_publication.h"
+#include "mvog_ros/shared_map.h"
+#include "mvog_ros/visualization.h"
+
+namespace mvog_ros {
+
+/// ~projected_map (the band [~projection_min_z, ~projection_max_z]: occupied, free or unknown)
+/// and ~cross_section_K (p at the K-th of ~cross_section_heights) as nav_msgs/OccupancyGrid,
+/// latched, each kept up to date tile by tile (IncrementalGrid): every ~publish_period the grid
+/// if it changed, and on ~..._updates (map_msgs/OccupancyGridUpdate) the rectangle that changed.
+/// No grid larger than ~max_cross_section_cells is published.
+class GridPublication : public ChangePublication {
+ public:
+  GridPublication(ros::NodeHandle& private_nh, const PublicationsConfig& config,
+                  const std::string& frame_id, double occupancy_threshold,
+                  int max_cross_section_cells, const SharedMap& shared_map);
+  ~GridPublication() override;
+
+ private:
+  /// One grid: the projected map, or one cross-section.
+  struct Layer {
+    IncrementalGrid grid;
+    ros::Publisher publisher;
+    ros::Publisher updates_publisher;
+  };
+
+  /// Every grid as unknown: a new subscriber is not shown the previous map.
+  void clearPublished() override;
+  void publishTiles(const std::vector<mvog::TileIndex>& changed) override;
+  void send(const ros::SingleSubscriberPublisher& subscriber, std::size_t layer);
+  /// Brings `layer` up to date (IncrementalGrid::update): the rectangle that changed, or nothing
+  /// (with a warning) if the map has outgrown ~max_cross_section_cells.
+  std::optional<mvog::CellRange> update(Layer& layer, const std::vector<mvog::TileIndex>& changed,
+                                        bool& relaid_out);
+
+  const std::string frame_id_;
+  const int max_cross_section_cells_;
+  std::vector<Layer> layers_;  // the projected map, then one per ~cross_section_heights entry
+};
+
+}  // namespace mvog_ros

@@ -1,0 +1,112 @@
+#include "mvog_ros/insertion_worker.h"
+
+#include <chrono>
+#include <mutex>
+#include <shared_mutex>
+#include <utility>
+
+#include <ros/console.h>
+
+namespace mvog_ros {
+
+InsertionWorker::InsertionWorker(const InsertionWorkerConfig& config, SharedMap& shared_map)
+    : config_(config), map_(shared_map), thread_(&InsertionWorker::run, this) {}
+
+InsertionWorker::~InsertionWorker() { stop(); }
+
+void InsertionWorker::enqueue(mvog::Scan&& scan, const std::string& source) {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    if (queue_.size() >= static_cast<std::size_t>(config_.insertion_queue_size)) {
+      queue_.pop_front();  // keep the newest: the oldest view is the least useful
+      ++messages_dropped_queue_;
+      ROS_WARN_THROTTLE(kWarningPeriod,
+                        "mvog: insertion is slower than the sensors; dropped the oldest waiting "
+                        "message (%llu so far)",
+                        static_cast<unsigned long long>(messages_dropped_queue_.load()));
+    }
+    queue_.push_back({std::move(scan), source});
+  }
+  queue_changed_.notify_one();
+}
+
+void InsertionWorker::stop() {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    stopping_ = true;
+  }
+  queue_changed_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void InsertionWorker::run() {
+  for (;;) {
+    QueuedScan queued;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping, and what was queued is in the map
+      queued = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const mvog::InsertionResult result = insert(queued.scan);
+    insertion_nanoseconds_ +=
+        static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                       std::chrono::steady_clock::now() - start)
+                                       .count());
+    readings_inserted_ += result.inserted();
+    readings_rejected_ += result.rejected();
+    out_of_range_readings_ += result.out_of_range_readings;
+    obstacle_nanoseconds_ += static_cast<std::uint64_t>(1e9 * result.obstacle_seconds);
+    out_of_range_nanoseconds_ += static_cast<std::uint64_t>(1e9 * result.out_of_range_seconds);
+    ++messages_inserted_;
+    if (result.rejected_out_of_bounds > 0) {
+      ROS_WARN_THROTTLE(kWarningPeriod,
+                        "mvog: %zu readings of a %s lie beyond ~max_coordinate and were rejected",
+                        result.rejected_out_of_bounds, queued.source.c_str());
+    }
+  }
+}
+
+mvog::InsertionResult InsertionWorker::insert(const mvog::Scan& scan) {
+  // The scan goes in whole (Fig. 2: the constraints once per scan). Its rasterisation reads
+  // nothing of the map but its configuration: it runs outside the lock, which queries and
+  // publications then wait for only while the scan's columns are merged.
+  mvog::MapConfig map_config;
+  {
+    std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
+    map_config = map_.map.config();
+  }
+  update_.prepare(scan, map_config, config_);
+  std::unique_lock<WriterPreferringMutex> lock(map_.mutex);
+  if (!update_.preparedFor(map_.map.config())) {
+    // ~load_map put a map of another configuration in place meanwhile.
+    update_.prepare(scan, map_.map.config(), config_);
+  }
+  return map_.map.apply(update_);
+}
+
+InsertionStatistics InsertionWorker::statistics() const {
+  InsertionStatistics statistics;
+  statistics.messages_inserted = messages_inserted_.load();
+  statistics.messages_dropped_queue = messages_dropped_queue_.load();
+  statistics.readings_inserted = readings_inserted_.load();
+  statistics.readings_rejected = readings_rejected_.load();
+  statistics.insertion_seconds = 1e-9 * static_cast<double>(insertion_nanoseconds_.load());
+  statistics.out_of_range_readings = out_of_range_readings_.load();
+  statistics.obstacle_seconds = 1e-9 * static_cast<double>(obstacle_nanoseconds_.load());
+  statistics.out_of_range_seconds = 1e-9 * static_cast<double>(out_of_range_nanoseconds_.load());
+  return statistics;
+}
+
+void InsertionWorker::resetStatistics() {
+  for (std::atomic<std::uint64_t>* counter :
+       {&messages_inserted_, &messages_dropped_queue_, &readings_inserted_, &readings_rejected_,
+        &insertion_nanoseconds_, &out_of_range_readings_, &obstacle_nanoseconds_,
+        &out_of_range_nanoseconds_}) {
+    counter->store(0);
+  }
+}
+
+}  // namespace mvog_ros

@@ -1,0 +1,122 @@
+#include "mvog_ros/publications/grid_publication.h"
+
+#include <algorithm>
+#include <shared_mutex>
+
+#include <map_msgs/OccupancyGridUpdate.h>
+#include <nav_msgs/OccupancyGrid.h>
+
+namespace mvog_ros {
+
+GridPublication::GridPublication(ros::NodeHandle& private_nh, const PublicationsConfig& config,
+                                 const std::string& frame_id, double occupancy_threshold,
+                                 int max_cross_section_cells, const SharedMap& shared_map)
+    : ChangePublication(shared_map),
+      frame_id_(frame_id),
+      max_cross_section_cells_(max_cross_section_cells) {
+  const double min_z = config.projection_min_z;
+  const double max_z = config.projection_max_z;
+  std::vector<IncrementalGrid> grids;
+  std::vector<std::string> topics;
+  grids.emplace_back(
+      min_z, max_cross_section_cells,
+      [min_z, max_z, occupancy_threshold](const mvog::Map& map, const mvog::CellRange& cells) {
+        return toOccupancyGrid(map.projection(min_z, max_z, occupancy_threshold, cells), 0.0, "",
+                               ros::Time())
+            .data;
+      });
+  topics.push_back("projected_map");
+  for (std::size_t k = 0; k < config.cross_section_heights.size(); ++k) {
+    const double height = config.cross_section_heights[k];
+    grids.emplace_back(
+        height, max_cross_section_cells,
+        [height](const mvog::Map& map, const mvog::CellRange& cells) {
+          return toOccupancyGrid(map.crossSection(height, cells), height, "", ros::Time()).data;
+        });
+    topics.push_back("cross_section_" + std::to_string(k));
+    ROS_INFO("mvog: ~%s is the cross-section at z = %.3f m", topics.back().c_str(), height);
+  }
+  // A subscriber's connection callback may run on another thread as soon as its topic is
+  // advertised: it waits for the layers to be complete.
+  std::lock_guard<std::mutex> publication_lock(mutex_);
+  for (std::size_t k = 0; k < grids.size(); ++k) {
+    layers_.push_back({std::move(grids[k]), ros::Publisher(), ros::Publisher()});
+    layers_[k].publisher = private_nh.advertise<nav_msgs::OccupancyGrid>(
+        topics[k], 1,
+        [this, k](const ros::SingleSubscriberPublisher& subscriber) { send(subscriber, k); },
+        ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true);
+    layers_[k].updates_publisher =
+        private_nh.advertise<map_msgs::OccupancyGridUpdate>(topics[k] + "_updates", 10);
+  }
+  start(private_nh, config.publish_period);
+}
+
+GridPublication::~GridPublication() { stop(); }
+
+void GridPublication::clearPublished() {
+  // The latched grids would show the previous map to every new subscriber: replace them by
+  // unknown ones until the new map has something to show.
+  const ros::Time stamp = ros::Time::now();
+  for (Layer& layer : layers_) {
+    nav_msgs::OccupancyGrid unknown = layer.grid.grid();
+    if (!unknown.data.empty()) {
+      std::fill(unknown.data.begin(), unknown.data.end(), std::int8_t{-1});
+      unknown.header.frame_id = frame_id_;
+      unknown.header.stamp = stamp;
+      unknown.info.map_load_time = stamp;
+      layer.publisher.publish(unknown);
+    }
+    layer.grid.clear();
+  }
+}
+
+void GridPublication::publishTiles(const std::vector<mvog::TileIndex>& changed) {
+  const ros::Time stamp = ros::Time::now();
+  for (Layer& layer : layers_) {
+    bool relaid_out = false;
+    const std::optional<mvog::CellRange> touched = update(layer, changed, relaid_out);
+    if (!touched || touched->empty()) continue;
+    nav_msgs::OccupancyGrid grid = layer.grid.grid();
+    grid.header.frame_id = frame_id_;
+    grid.header.stamp = stamp;
+    grid.info.map_load_time = stamp;
+    if (layer.publisher.getNumSubscribers() > 0) layer.publisher.publish(grid);
+    if (!relaid_out && layer.updates_publisher.getNumSubscribers() > 0) {
+      map_msgs::OccupancyGridUpdate update = layer.grid.updateOf(*touched);
+      update.header = grid.header;
+      layer.updates_publisher.publish(update);
+    }
+  }
+}
+
+void GridPublication::send(const ros::SingleSubscriberPublisher& subscriber, std::size_t layer) {
+  std::lock_guard<std::mutex> publication_lock(mutex_);
+  std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
+  restartIfReplacedLocked();
+  Layer& sent = layers_[layer];
+  bool relaid_out = false;
+  if (!update(sent, map_.map.tilesModifiedSince(published_.revision), relaid_out) ||
+      sent.grid.cells().empty()) {  // too large, or nothing mapped yet
+    return;
+  }
+  nav_msgs::OccupancyGrid grid = sent.grid.grid();
+  grid.header.frame_id = frame_id_;
+  grid.header.stamp = ros::Time::now();
+  subscriber.publish(grid);
+}
+
+std::optional<mvog::CellRange> GridPublication::update(Layer& layer,
+                                                       const std::vector<mvog::TileIndex>& changed,
+                                                       bool& relaid_out) {
+  try {
+    return layer.grid.update(map_.map, changed, relaid_out);
+  } catch (const GridTooLarge& e) {
+    ROS_WARN_THROTTLE(kWarningPeriod,
+                      "mvog: %s not published: %s, more than ~max_cross_section_cells (%d); "
+                      "readings far away? (~max_coordinate, ~max_range)",
+                      layer.publisher.getTopic().c_str(), e.what(), max_cross_section_cells_);
+    return std::nullopt;
+  }
+}
+
+}  // namespace mvog_ros

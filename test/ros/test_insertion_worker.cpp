@@ -1,0 +1,155 @@
+// InsertionWorker (mvog_ros/insertion_worker.h): every queued scan goes into the map or is
+// counted as dropped (the oldest first when the queue is full), pieces of large scans build the
+// map of the whole scan, and stop() inserts what is queued.
+#include <gtest/gtest.h>
+
+#include <mutex>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include <ros/time.h>
+
+#include "mvog/map_io.h"
+#include "mvog_ros/insertion_worker.h"
+
+namespace mvog_ros {
+namespace {
+
+mvog::MapConfig mapConfig() {
+  mvog::MapConfig config;
+  config.resolution = 0.1;
+  config.max_coordinate = 100.0;
+  return config;
+}
+
+/// `hits` obstacle readings from `origin`, some NaN (rejected by the core), around (5, 0, 1).
+mvog::Scan scanOf(std::size_t hits, std::size_t nan_hits, const Eigen::Vector3d& origin,
+                  std::uint32_t seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> spread(-2.0f, 2.0f);
+  mvog::Scan scan;
+  scan.origin = origin;
+  for (std::size_t k = 0; k < hits; ++k) scan.hits.emplace_back(5.0f, spread(random), 1.0f);
+  for (std::size_t k = 0; k < nan_hits; ++k) scan.hits.emplace_back(NAN, 0.0f, 1.0f);
+  scan.out_of_range.emplace_back(0.0f, 5.0f, 1.0f);
+  return scan;
+}
+
+class InsertionWorkerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { ros::Time::init(); }  // the throttled warnings read the time
+};
+
+TEST_F(InsertionWorkerTest, InsertsWhatIsQueuedAndCountsWhatItDid) {
+  SharedMap shared_map{mvog::Map(mapConfig())};
+  InsertionWorkerConfig config;
+  config.insertion_queue_size = 10;
+  InsertionWorker worker(config, shared_map);
+  for (std::uint32_t k = 0; k < 5; ++k) worker.enqueue(scanOf(100, 2, {0, 0, 1}, k), "test");
+  worker.stop();  // inserts what is queued first
+  const InsertionStatistics statistics = worker.statistics();
+  EXPECT_EQ(statistics.messages_inserted, 5u);
+  EXPECT_EQ(statistics.messages_dropped_queue, 0u);
+  EXPECT_EQ(statistics.readings_inserted, 5u * 101);  // hits and the out-of-range reading
+  EXPECT_EQ(statistics.readings_rejected, 5u * 2);    // the NaN hits
+  EXPECT_GE(statistics.insertion_seconds, 0.0);
+  EXPECT_EQ(shared_map.map.occupancy({5.05, 0.05, 1.0}).state(0.5),
+            mvog::OccupancyState::kOccupied);
+
+  worker.resetStatistics();
+  const InsertionStatistics reset = worker.statistics();
+  EXPECT_EQ(reset.messages_inserted, 0u);
+  EXPECT_EQ(reset.readings_inserted, 0u);
+  EXPECT_EQ(reset.readings_rejected, 0u);
+  EXPECT_EQ(reset.insertion_seconds, 0.0);
+}
+
+TEST_F(InsertionWorkerTest, AFullQueueDropsTheOldestAndKeepsTheNewest) {
+  SharedMap shared_map{mvog::Map(mapConfig())};
+  InsertionWorkerConfig config;
+  config.insertion_queue_size = 1;
+  InsertionWorker worker(config, shared_map);
+  constexpr std::uint32_t kScans = 6;
+  {
+    // While the map is held, the worker cannot insert: the queue fills up.
+    std::unique_lock<WriterPreferringMutex> hold(shared_map.mutex);
+    for (std::uint32_t k = 0; k < kScans; ++k) {
+      mvog::Scan scan = scanOf(10, 0, {0, 0, 1}, k);
+      if (k == kScans - 1) scan.hits = {{3.05f, 7.05f, 1.0f}};  // the newest, seen nowhere else
+      worker.enqueue(std::move(scan), "test");
+    }
+  }
+  worker.stop();
+  const InsertionStatistics statistics = worker.statistics();
+  // The worker may have taken the first scan before the map was held: 1 or 2 inserted.
+  EXPECT_EQ(statistics.messages_inserted + statistics.messages_dropped_queue, kScans);
+  EXPECT_GE(statistics.messages_dropped_queue, kScans - 2);
+  EXPECT_EQ(shared_map.map.occupancy({3.05, 7.05, 1.0}).state(0.5),
+            mvog::OccupancyState::kOccupied);
+}
+
+TEST_F(InsertionWorkerTest, AScanPreparedOutsideTheLockBuildsTheMapOfInsertScan) {
+  // The worker rasterises outside the map's lock and applies under it: the map of
+  // Map::insertScan, with the default rules and with the paper's, on 1 or 2 threads.
+  const mvog::Scan large = scanOf(50000, 10, {0.3, -0.2, 1.2}, 7);
+  for (const mvog::ModelRules& rules : {mvog::ModelRules{}, mvog::ModelRules::paper()}) {
+    for (int threads : {1, 2}) {
+      mvog::MapConfig map_config = mapConfig();
+      map_config.rules = rules;
+      InsertionWorkerConfig config;
+      config.insertion_threads = threads;
+      mvog::Map whole(map_config);
+      const mvog::InsertionResult expected = whole.insertScan(large, config);
+
+      SharedMap shared_map{mvog::Map(map_config)};
+      InsertionWorker worker(config, shared_map);
+      worker.enqueue(mvog::Scan(large), "test");
+      worker.stop();
+      EXPECT_EQ(mvog::serializeMap(shared_map.map), mvog::serializeMap(whole))
+          << threads << " threads";
+      EXPECT_EQ(worker.statistics().readings_inserted, expected.inserted());
+      EXPECT_EQ(worker.statistics().readings_rejected, expected.rejected());
+      EXPECT_EQ(worker.statistics().out_of_range_readings, expected.out_of_range_readings);
+    }
+  }
+}
+
+TEST_F(InsertionWorkerTest, ScansGoIntoMapsReplacedWhileTheyArePrepared) {
+  // ~load_map may put a map of another resolution or other rules in place between a scan's
+  // preparation (outside the lock) and its application: the worker prepares it again for the
+  // map in place. Maps of two configurations replace each other while scans are inserted.
+  SharedMap shared_map{mvog::Map(mapConfig())};
+  InsertionWorkerConfig config;
+  config.insertion_queue_size = 1000;
+  InsertionWorker worker(config, shared_map);
+  mvog::MapConfig other = mapConfig();
+  other.resolution *= 2.0;
+  other.rules = mvog::ModelRules::paper();
+  constexpr int kScans = 200;
+  std::thread loader([&] {
+    for (int k = 0; k < kScans; ++k) {
+      std::unique_lock<WriterPreferringMutex> lock(shared_map.mutex);
+      shared_map.replace(mvog::Map(k % 2 == 0 ? other : mapConfig()));
+    }
+  });
+  for (int k = 0; k < kScans; ++k) worker.enqueue(scanOf(200, 0, {0.3, -0.2, 1.2}, 3), "test");
+  loader.join();
+  worker.stop();
+  EXPECT_EQ(worker.statistics().messages_inserted, static_cast<std::uint64_t>(kScans));
+  EXPECT_EQ(worker.statistics().readings_inserted, kScans * 201u);  // 200 hits, 1 out of range
+  EXPECT_EQ(shared_map.map.resolution(), mapConfig().resolution);
+}
+
+TEST_F(InsertionWorkerTest, NothingIsInsertedAfterStop) {
+  SharedMap shared_map{mvog::Map(mapConfig())};
+  InsertionWorker worker(InsertionWorkerConfig(), shared_map);
+  worker.stop();
+  worker.enqueue(scanOf(10, 0, {0, 0, 1}, 1), "test");
+  worker.stop();  // stopping twice is fine
+  EXPECT_EQ(worker.statistics().messages_inserted, 0u);
+  EXPECT_TRUE(shared_map.map.empty());
+}
+
+}  // namespace
+}  // namespace mvog_ros
