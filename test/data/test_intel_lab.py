@@ -116,23 +116,21 @@ class IntelLab(data.DataTestCase):
         means /= counts[:, None]
         walls = data.sample(means[scans_per_cell >= 10], 2000)
         walls[:, 2] = self.height
-        # The model itself leaves many wall cells "free": eq. (9) is the reflection-map ratio
-        # hits / (hits + misses), and at a wall every scan sends many rays through the wall's
-        # cells at a shallow angle (to hit the wall further along, or through the wall's ragged
-        # 5 cm rasterisation, Sec. V.B) while only the few beams that end there add hits. A 2D
-        # hits/misses count over this bag (every ray walked through the 5 cm grid) gives
-        # p > 0.5 in only 53 % of these cells, but 88 % of them have an occupied cell within one
-        # cell. So: the wall is there as a line of occupied cells (>= 80 % within one cell), and
-        # the exact cells match the model's ~50 % (>= 40 %).
+        # Eq. (9) is the reflection-map ratio hits / (hits + misses), and at a wall other scans
+        # send rays through the wall's cells at a shallow angle (to hit the wall further along,
+        # or through its ragged 5 cm rasterisation, Sec. V.B); the paper's model leaves about half
+        # of these cells free. With the default rules (a scan's free space never erases its own
+        # hits, a scan counts once per cell, p > 0.324 occupied), measured: 90 % of the walls'
+        # own cells occupied, 99.7 % with an occupied cell within one cell.
         offsets = np.array([(dx, dy, 0.0) for dx in (-1, 0, 1) for dy in (-1, 0, 1)])
         neighbourhood = (walls[:, None, :] + self.resolution * offsets[None]).reshape(-1, 3)
         states, _ = data.query(neighbourhood)
         near = np.any(states.reshape(len(walls), 9) == data.OCCUPIED, axis=1)
         print("wall clusters: %.1f %% of %d have an occupied cell within one cell"
               % (100 * near.mean(), len(walls)))
-        self.assertGreaterEqual(near.mean(), 0.8, "wall clusters without an occupied cell "
+        self.assertGreaterEqual(near.mean(), 0.97, "wall clusters without an occupied cell "
                                 "within one cell: %s" % walls[~near][:5])
-        self.assertFraction(walls, data.OCCUPIED, 0.4, "wall clusters (their own cell)")
+        self.assertFraction(walls, data.OCCUPIED, 0.85, "wall clusters (their own cell)")
 
     def test_laser_path_is_free(self):
         # 0.3 m ahead of the laser, within its 180 degree fan, where the beam straight ahead

@@ -126,15 +126,12 @@ class NewCollege(data.DataTestCase):
         self.assertAlmostEqual(np.median(medians), 4.0, delta=0.75)
 
     def test_wall_is_occupied_at_every_height(self):
-        # 400 wall returns per height band, queried where they fell. Not every such cell is
-        # occupied, and the model predicts it: eq. (9) is the ratio of hits to rays through the
-        # space, and the wall (with vegetation in front) runs diagonally across the grid, so rays
-        # ending just behind its ragged face cut through the cells of other scans' returns at the
-        # same heights (Sec. V.B's rasterisation); the canopy at 3.5-4.5 m is hit by one scan and
-        # seen through by the next. A plain hits/(hits + misses) count in 10 cm voxels over this
-        # bag has only 83, 76, 75 and 58 % of these cells above 0.5 in the four bands. So: the
-        # wall is there at every height as occupied cells within one cell of its returns
-        # (>= 80 %), and at least half of the returns' own cells are occupied.
+        # 400 wall returns per height band, queried where they fell. The wall (with vegetation in
+        # front) runs diagonally across the grid, so rays ending just behind its ragged face cut
+        # through the cells of other scans' returns at the same heights (Sec. V.B's
+        # rasterisation); the canopy at 3.5-4.5 m is hit by one scan and seen through by the
+        # next. The paper's model keeps a quarter of the returns' cells occupied; with the
+        # default rules, measured: 94-97 % in the four bands, 99-100 % within one cell.
         offsets = np.array([(dx, dy, 0.0) for dx in (-1, 0, 1) for dy in (-1, 0, 1)])
         results = []
         for low, high in WALL_BANDS:
@@ -148,9 +145,9 @@ class NewCollege(data.DataTestCase):
                   "cell" % (low, high, 100 * own, len(points), 100 * near))
         for low, high, own, near in results:
             what = "left wall %.1f-%.1f m above the ground" % (low, high)
-            self.assertGreaterEqual(near, 0.8, what + ": too few returns with an occupied cell "
+            self.assertGreaterEqual(near, 0.97, what + ": too few returns with an occupied cell "
                                     "within one cell")
-            self.assertGreaterEqual(own, 0.5, what + ": too few returns in an occupied cell")
+            self.assertGreaterEqual(own, 0.9, what + ": too few returns in an occupied cell")
 
     def test_beside_the_scanners_is_free(self):
         # 0.6 m outward from each scanner along its horizontal beam (clear of the robot, which
@@ -164,8 +161,9 @@ class NewCollege(data.DataTestCase):
 
     def test_open_sky_on_the_right_is_free(self):
         # The right scanner's beams 0-90 (45 degrees up to horizontal) saw nothing (+Inf: open
-        # sky, README); with ~insert_out_of_range they clear space out to ~max_range. 10 m along
-        # the beam 22.5 degrees above horizontal (the beam at 67.5 degrees in the laser frame).
+        # sky, README); with ~insert_out_of_range they clear space out to tilting_laser.yaml's
+        # ~out_of_range_free_length of 15 m. 10 m along the beam 22.5 degrees above horizontal
+        # (the beam at 67.5 degrees in the laser frame).
         points = self.beam_points("laser_right", np.radians(67.5), 10.0,
                                   lambda r, ok: np.isposinf(r))
         self.assertGreater(len(points), 200)

@@ -159,7 +159,7 @@ class PeopleStationary(data.DataTestCase):
         self.assertGreater(len(walls), 20, "expected static walls")
         # The scanner does not move, so the same beams end in the same cells every scan; a few
         # cells still get rays of neighbouring beams through a corner (Sec. V.B).
-        self.assertFraction(self.at_height(walls), data.OCCUPIED, 0.8, "static walls")
+        self.assertFraction(self.at_height(walls), data.OCCUPIED, 0.97, "static walls")
 
     def test_in_front_of_the_scanner_is_free(self):
         points = self.origin + np.outer([0.2, 0.3, 0.4], self.forward)
