@@ -193,10 +193,11 @@ bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, Re
   return true;
 }
 
-/// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`.
+/// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`
+/// (a copy of the chunk's writer, local to the ray so that the walk keeps it in registers).
 template <class Writer>
 void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
-                bool model_negative_space, Writer& scratch) {
+                bool model_negative_space, Writer scratch) {
   const auto end_z = static_cast<float>(end.z());
   if (!model_negative_space) {
     // Only the obstacle's own volume, in the cell the walk would end in (see walkRay): no walk.
