@@ -130,7 +130,7 @@ TEST_F(BenchSmokeTest, ReadsEveryNodeOfAGraphItWrote) {
   const std::string json = directory_ + "/two.json";
   std::string errors;
   ASSERT_EQ(runBench("--input '" + input + "' --resolution 0.1 --resolution 0.2 --threads 2 " +
-                         "--json '" + json + "'",
+                         "--repeat 2 --json '" + json + "'",
                      errors),
             0)
       << errors;
@@ -140,6 +140,7 @@ TEST_F(BenchSmokeTest, ReadsEveryNodeOfAGraphItWrote) {
     EXPECT_EQ(result["readings"].asUInt64(), 5u);
   }
   EXPECT_EQ(root["input"]["scans"].asUInt64(), 2u);
+  EXPECT_EQ(root["repeat"].asInt(), 2);
 }
 
 TEST_F(BenchSmokeTest, RefusesBadInputWithAMessage) {
@@ -157,6 +158,8 @@ TEST_F(BenchSmokeTest, RefusesBadInputWithAMessage) {
   EXPECT_NE(errors.find("neither a ROS bag"), std::string::npos) << errors;
 
   EXPECT_EQ(runBench("--input x --backend nothing", errors), 2);
+  EXPECT_EQ(runBench("--input x --repeat 0", errors), 2);
+  EXPECT_NE(errors.find("--repeat needs a whole number"), std::string::npos) << errors;
 }
 
 }  // namespace

@@ -204,6 +204,9 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                report.rules == mvog::ModelRules::paper() ? " (the paper's model)" : "",
                report.occupancy_threshold);
 
+  if (report.repeat > 1) {
+    std::fprintf(out, "timings     the fastest of %d insertions per backend\n\n", report.repeat);
+  }
   std::fprintf(out, "%-8s %7s %7s %10s %10s %12s %14s %14s %14s\n", "backend", "res (m)", "threads",
                "readings", "insert (s)", "readings/s", "memory (B)", "file (B)", ".ot file (B)");
   for (const ResolutionReport& r : report.resolutions) {
@@ -375,6 +378,7 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
       .add("rules", rulesText(report.rules))
       .add("out_of_range_to_mvog", report.out_of_range)
       .add("occupancy_threshold", report.occupancy_threshold)
+      .add("repeat", report.repeat)
       .add("table_one", table_one)
       .add("quality", quality)
       .add("comparison", comparison)

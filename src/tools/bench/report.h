@@ -29,6 +29,7 @@ struct BenchReport {
   mvog::ModelRules rules;
   double occupancy_threshold = 0.0;
   bool out_of_range = false;  ///< the out-of-range readings were given to MVOG
+  int repeat = 1;             ///< insertions per backend; the fastest is reported
   std::vector<ResolutionReport> resolutions;
 };
 
