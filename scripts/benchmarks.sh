@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Every figure of BENCHMARKS.md, from a fresh clone: installs what is missing, builds (Release),
+# runs mvog_bench on every shared recording (MVOG, OctoMap and the bare walk on the same rays, in
+# one run per file), MVOG with 2 threads and with the paper's model, and mvog_microbench; writes
+# the outputs (JSON and text) to OUT and prints the report's tables (scripts/benchmark_tables.py).
+#   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~15 min here)
+# MVOG_BENCH_REPEAT (default 3): insertions per backend, the fastest reported.
+source "$(dirname "$0")/common.sh"
+
+OUT=${1:-$WORKSPACE/benchmarks}
+REPEAT=${MVOG_BENCH_REPEAT:-3}
+install_missing_packages
+build_workspace
+# shellcheck disable=SC1091
+source "$WORKSPACE/devel/setup.bash"
+BENCH=$WORKSPACE/devel/lib/mvog/mvog_bench
+[ -d "$MVOG_DATA_DIR" ] || { echo "no shared data at $MVOG_DATA_DIR (set MVOG_DATA_DIR)" >&2; exit 1; }
+mkdir -p "$OUT"
+cut -d' ' -f1-3 /proc/loadavg >"$OUT/load_average_before"
+
+# The 2D laser logs also at 0.1 m, the cell size their users map at.
+declare -A RESOLUTIONS=(
+  [intel_lab.bag]="0.1 0.05" [people_stationary.bag]="0.1 0.05"
+)
+FILES=(spherical_scan.graph newcollege_excerpt.bag intel_lab.bag people_stationary.bag
+  kurt3d_3scans.bag kurt3d_3scans.graph tum_fr2_pioneer_slam2_10frames.graph
+  tum_fr2_pioneer_10frames.bag)
+THREADED_FILES=(kurt3d_3scans.graph tum_fr2_pioneer_slam2_10frames.graph
+  tum_fr2_pioneer_10frames.bag)
+
+run_bench() {
+  local name=$1
+  shift
+  echo "mvog_bench $* -> $OUT/$name.json"
+  "$BENCH" "$@" --repeat "$REPEAT" --json "$OUT/$name.json" >"$OUT/$name.txt" 2>"$OUT/$name.log"
+}
+
+for file in "${FILES[@]}"; do
+  resolutions=()
+  for r in ${RESOLUTIONS[$file]:-0.05}; do resolutions+=(--resolution "$r"); done
+  run_bench "all_$file" --input "$MVOG_DATA_DIR/$file" "${resolutions[@]}" --backend all
+  run_bench "paper_$file" --input "$MVOG_DATA_DIR/$file" "${resolutions[@]}" --backend mvog \
+    --model paper
+done
+for file in "${THREADED_FILES[@]}"; do
+  run_bench "threads2_$file" --input "$MVOG_DATA_DIR/$file" --resolution 0.05 --backend mvog \
+    --threads 2
+done
+echo "mvog_microbench -> $OUT/microbench.json"
+"$WORKSPACE/devel/lib/mvog/mvog_microbench" --benchmark_out="$OUT/microbench.json" \
+  --benchmark_out_format=json >"$OUT/microbench.txt" 2>&1
+cut -d' ' -f1-3 /proc/loadavg >"$OUT/load_average_after"
+python3 "$REPO/scripts/benchmark_tables.py" "$OUT" | tee "$OUT/tables.md"
