@@ -100,7 +100,7 @@ def main(out):
     repeat = next(iter(runs.values())).get("repeat", 1)
     print(f"Load average (1, 5, 15 min) before: {read_text('load_average_before')}, "
           f"after: {read_text('load_average_after')}; timings: the fastest of {repeat} "
-          "insertions per backend.\n")
+          "insertion(s) per backend.\n")
     print("### Quality (% of the sampled points)\n")
     print(table(["file", "res (m)", "ends occupied: MVOG", "OctoMap", "paper model",
                  "along free: MVOG", "OctoMap", "paper model", "far unknown: MVOG", "OctoMap"],
