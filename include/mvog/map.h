@@ -85,7 +85,7 @@ struct ColumnView {
 /// Memory held by the map.
 struct MemoryUsage {
   /// Bytes the map holds: its tiles, the index of tiles and every cell's volume storage with
-  /// its spare capacity (allocator bookkeeping not included).
+  /// its spare capacity, and its record of removed tiles (allocator bookkeeping not included).
   std::size_t bytes_held = 0;
   /// The paper's Table I accounting: 12 bytes per volume plus an 8-byte reference per cell of
   /// the minimal 2D grid that holds every cell with a volume.
@@ -105,6 +105,13 @@ struct TileIndex {
   friend bool operator==(const TileIndex& a, const TileIndex& b) {
     return a.x == b.x && a.y == b.y;
   }
+};
+
+/// What Map::forget removed.
+struct ForgetResult {
+  std::size_t volumes_removed = 0;  ///< positive volumes and negative volumes (each piece counted)
+  std::size_t cells_emptied = 0;    ///< cells left without a volume, now unknown
+  std::size_t tiles_freed = 0;      ///< tiles left without a cell, their memory released
 };
 
 class ScanUpdate;
@@ -219,6 +226,35 @@ class Map {
   /// Emptying a cell removes it from bounds().
   void setCellVolumes(const std::vector<CellAssignment>& cells);
   void setCellVolumes(const CellIndex& cell, const CellVolumes& volumes);
+
+  // ---- A map's lifetime: forgetting, a local window, clearing ------------------------------
+
+  /// Forgetting (after a decay step): removes every positive volume whose real mass is below
+  /// `min_mass`, and every run of touching negative volumes (the pieces of one free volume split
+  /// at obstacles, ModelRules::split_free_space_at_obstacles) whose mass together is below it;
+  /// their space becomes unknown. Negative pieces that touched at a removed positive volume's
+  /// bottom or top are merged again (ListMerger), so every column stays valid. A cell left empty
+  /// is removed, a tile left empty freed. `min_mass` 0 forgets nothing; it must be finite and
+  /// >= 0 (ConfigError). A tile that nothing could have made lighter since the last call costs
+  /// a look at its header: cheap enough for every decay step.
+  ForgetResult forget(double min_mass);
+  /// Removes the tiles wholly farther than `radius` (m) in xy from `centre` and returns them as a
+  /// map of this configuration and mass unit (masses exact), for the caller to save or merge
+  /// elsewhere. Throws ConfigError for a non-finite centre or a NaN or negative radius.
+  Map dropTilesFartherThan(const Eigen::Vector2d& centre, double radius);
+  /// Makes the box [min_corner, max_corner] (m) unknown: in the cells whose squares meet its
+  /// footprint ([floor(s min), ceil(s max)) in x and y), volumes are cut at its bottom and top,
+  /// the parts outside keeping their mass in proportion to their height (parts lower than 1
+  /// go too: Sec. III-A); a column wholly inside is removed. A box lower than one cell's height
+  /// (1 / s) is cleared a little over one cell high around its centre: a column cannot hold a
+  /// gap of 1 or less. Infinite corners are allowed. Returns the number of cells changed.
+  /// Throws ConfigError, changing nothing, for a NaN corner or a box empty or inverted on an axis.
+  std::size_t clearBox(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& max_corner);
+  /// The tiles removed after `revision` (by forget, dropTilesFartherThan, clearBox,
+  /// setCellVolumes) that do not exist now, rows from the lowest; nothing if the map
+  /// no longer knows (clear() since, or more removals since than it remembers, a bounded number):
+  /// then treat every tile as changed.
+  std::optional<std::vector<TileIndex>> tilesRemovedSince(std::uint64_t revision) const;
 
  private:
   struct Storage;
