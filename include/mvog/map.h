@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -112,6 +113,27 @@ struct ForgetResult {
   std::size_t volumes_removed = 0;  ///< positive volumes and negative volumes (each piece counted)
   std::size_t cells_emptied = 0;    ///< cells left without a volume, now unknown
   std::size_t tiles_freed = 0;      ///< tiles left without a cell, their memory released
+};
+
+/// A transform between two maps of one resolution that keeps the grid, so that merging moves
+/// volumes from cell to cell without resampling them (Map::merge): a rotation about z by
+/// quarter_turns x 90 degrees (counter-clockwise), then a translation by whole cells in x and y
+/// and by dz metres in z. A quarter turn takes cell (i, j), the square [i, i + 1) x [j, j + 1),
+/// to the square [-j - 1, -j) x [i, i + 1): cell (-j - 1, i).
+struct GridTransform {
+  int quarter_turns = 0;  ///< any integer; taken modulo 4
+  std::int64_t dx_cells = 0;
+  std::int64_t dy_cells = 0;
+  double dz = 0.0;  ///< metres
+
+  /// The transform `this_from_other` (a homogeneous 4 x 4 matrix, metres) as a GridTransform for
+  /// maps of `resolution`. Throws ConfigError saying why if it is not finite, not rigid, has a
+  /// roll or pitch, a yaw that is no multiple of 90 degrees, or an x or y translation that is no
+  /// whole number of cells (each to within 1e-6 of a cell, or of 1 in the rotation's entries):
+  /// any of those would need the volumes resampled.
+  static GridTransform fromMatrix(const Eigen::Matrix4d& this_from_other, double resolution);
+  /// Where a cell of the other map goes: (x, y), in 64 bits (it may lie beyond any map).
+  std::array<std::int64_t, 2> target(const CellIndex& cell) const;
 };
 
 class ScanUpdate;
@@ -227,7 +249,7 @@ class Map {
   void setCellVolumes(const std::vector<CellAssignment>& cells);
   void setCellVolumes(const CellIndex& cell, const CellVolumes& volumes);
 
-  // ---- A map's lifetime: forgetting, a local window, clearing ------------------------------
+  // ---- A map's lifetime: forgetting, a local window, clearing, merging ----------------------
 
   /// Forgetting (after a decay step): removes every positive volume whose real mass is below
   /// `min_mass`, and every run of touching negative volumes (the pieces of one free volume split
@@ -250,6 +272,15 @@ class Map {
   /// gap of 1 or less. Infinite corners are allowed. Returns the number of cells changed.
   /// Throws ConfigError, changing nothing, for a NaN corner or a box empty or inverted on an axis.
   std::size_t clearBox(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& max_corner);
+  /// Adds `other` into this map by the constraint application of Sec. III-B.3 (ListMerger, with
+  /// this map's rules, as insertion does): every cell of `other`, moved by `this_from_other`,
+  /// has its lists merged with this map's, overlapping volumes' masses summed (eq. 7), gaps of
+  /// at most 1 closed at density 1 (eq. 8). Masses are brought to this map's unit (exact unless
+  /// this map has decayed: then within a float rounding). Throws ConfigError, changing nothing,
+  /// if the resolutions differ, if the maps count mass differently (ModelRules::mass_counting:
+  /// their masses mean different things), or if a cell would land beyond max_coordinate. Other
+  /// rules may differ: this map's rules shape the merged lists. `other` may be this map.
+  void merge(const Map& other, const GridTransform& this_from_other = {});
   /// The tiles removed after `revision` (by forget, dropTilesFartherThan, clearBox,
   /// setCellVolumes) that do not exist now, rows from the lowest; nothing if the map
   /// no longer knows (clear() since, or more removals since than it remembers, a bounded number):

@@ -56,5 +56,10 @@ void saveMap(const Map& map, const std::string& path);
 void saveMapBytes(const std::vector<std::uint8_t>& bytes, const std::string& path);
 /// Throws MapFileError if the file cannot be read or is not a valid map.
 Map loadMap(const std::string& path);
+/// Merges `part` (Map::merge, no transform) into the map saved at `path`, or saves it there if
+/// there is no file, atomically (saveMap): what a map's tiles dropped by dropTilesFartherThan
+/// are kept in. Throws MapFileError, leaving the file as it was, if it cannot be read, is not a
+/// valid map or cannot take `part` (another resolution or mass counting).
+void mergeIntoMapFile(const Map& part, const std::string& path);
 
 }  // namespace mvog

@@ -267,4 +267,20 @@ Map loadMap(const std::string& path) {
   }
 }
 
+void mergeIntoMapFile(const Map& part, const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    if (error) throw MapFileError("cannot inspect '" + path + "': " + error.message());
+    saveMap(part, path);
+    return;
+  }
+  Map saved = loadMap(path);
+  try {
+    saved.merge(part);
+  } catch (const ConfigError& e) {
+    throw MapFileError("cannot merge into '" + path + "': " + e.what());
+  }
+  saveMap(saved, path);
+}
+
 }  // namespace mvog

@@ -2,9 +2,13 @@
 // of the tiles removed.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <random>
@@ -276,6 +280,22 @@ TEST(DropTiles, DropsTheTilesWhollyFartherAndReturnsThemExactly) {
     EXPECT_EQ(m->bounds().min, tight.min);
     EXPECT_EQ(m->bounds().max, tight.max);
   }
+}
+
+TEST(DropTiles, MergingWhatWasDroppedBackGivesTheMapAgain) {
+  Map map = test::randomMap(10, 0.1, 10.0, 4);
+  const Bytes whole = serialized(map);
+  char directory[] = "/tmp/mvog_drop_XXXXXX";
+  ASSERT_NE(::mkdtemp(directory), nullptr);
+  const std::string file = std::string(directory) + "/dropped.mvog";
+  // Two steps of a window moving away, each saving what it dropped into the same file.
+  mergeIntoMapFile(map.dropTilesFartherThan({-6.0, 0.0}, 5.0), file);
+  mergeIntoMapFile(map.dropTilesFartherThan({0.0, 0.0}, 3.0), file);
+  Map saved = loadMap(file);
+  saved.merge(map);
+  EXPECT_EQ(serialized(saved), whole);
+  std::remove(file.c_str());
+  ::rmdir(directory);
 }
 
 TEST(DropTiles, RefusesBadInputAndDropsNothingWhenAllIsNear) {
