@@ -139,7 +139,8 @@ struct GridTransform {
 class ScanUpdate;
 namespace detail {
 class TileBlock;
-}
+struct MapUpdateCodec;
+}  // namespace detail
 
 /// A Multi-Volume Occupancy Grid (Dryanovski, Morris, Xiao, IROS 2010).
 ///
@@ -282,13 +283,14 @@ class Map {
   /// rules may differ: this map's rules shape the merged lists. `other` may be this map.
   void merge(const Map& other, const GridTransform& this_from_other = {});
   /// The tiles removed after `revision` (by forget, dropTilesFartherThan, clearBox,
-  /// setCellVolumes) that do not exist now, rows from the lowest; nothing if the map
+  /// setCellVolumes, a map update) that do not exist now, rows from the lowest; nothing if the map
   /// no longer knows (clear() since, or more removals since than it remembers, a bounded number):
   /// then treat every tile as changed.
   std::optional<std::vector<TileIndex>> tilesRemovedSince(std::uint64_t revision) const;
 
  private:
   struct Storage;
+  friend struct detail::MapUpdateCodec;  // map_update.cpp: tiles as stored, for exact mirrors
 
   const detail::TileBlock* findTile(std::uint64_t key) const;
   template <class T, class CellValue>

@@ -1,10 +1,14 @@
 // A map's lifetime: forgetting what decayed, dropping far tiles, clearing a box, and the record
 // of removed tiles that incremental publication and map updates need.
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <iterator>
 #include <limits>
 #include <string>
+
+#include <unistd.h>
 
 #include "map_storage.h"
 #include "mvog/constraints.h"
@@ -37,6 +41,19 @@ std::vector<std::uint64_t> TileRemovalLog::keysRemovedAfter(std::uint64_t revisi
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   return keys;
+}
+
+std::uint64_t newMapId() {
+  // splitmix64 over a per-process seed (time and process id) and a counter: distinct for every
+  // map of a process, and between processes but for a negligible chance.
+  static const std::uint64_t seed =
+      static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch().count()) ^
+      (static_cast<std::uint64_t>(::getpid()) << 40);
+  static std::atomic<std::uint64_t> counter{0};
+  std::uint64_t z = seed + 0x9e3779b97f4a7c15ull * (counter.fetch_add(1) + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
 }
 
 }  // namespace detail

@@ -115,6 +115,7 @@ void Map::decay(double k_d) {
       entry.second.rebaseExponent(unit_exponent_, detail::kMaxExponentLag);
     }
     unit_exponent_ = 0;
+    storage_->exponents_rebased_revision = revision_;
   }
 }
 

@@ -42,6 +42,9 @@ class TileRemovalLog {
   std::uint64_t complete_from_ = 0;
 };
 
+/// A number that tells maps apart (incremental updates name their source map with it).
+std::uint64_t newMapId();
+
 }  // namespace detail
 
 struct Map::Storage {
@@ -49,6 +52,10 @@ struct Map::Storage {
   /// By detail::tileKey; no tile is empty.
   Tiles tiles;
   detail::TileRemovalLog removals;
+  /// The revision of the last decay step that rebased the tiles' mass exponents (0: none): their
+  /// stored form changed, so an incremental update cannot span it.
+  std::uint64_t exponents_rebased_revision = 0;
+  std::uint64_t id = detail::newMapId();
 
   /// Erases a tile, remembering its removal at `revision`; returns the tile after it.
   Tiles::iterator removeTile(Tiles::iterator tile, std::uint64_t revision) {
