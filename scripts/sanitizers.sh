@@ -7,7 +7,8 @@
 #   catkin   g++, ASan + UBSan: the catkin package's ROS gtests and the rostests of mvog_node
 #            (bad input, time jumps, SIGKILL during saves, overload, the whole ROS interface);
 #   thread   g++, ThreadSanitizer: the concurrency tests;
-#   fuzz     clang++-14, libFuzzer + ASan + UBSan: each target for MVOG_FUZZ_SECONDS (25) seconds,
+#   fuzz     clang++-14, libFuzzer + ASan + UBSan: each target (map_file, map_update,
+#            conversions) for MVOG_FUZZ_SECONDS (25) seconds,
 #            seeded with test/fuzz/corpus/<target> and test/fuzz/regressions/<target>. A crash is
 #            written to $WORKSPACE/logs/fuzz/: copy it into test/fuzz/regressions/<target>/.
 # Called by scripts/test.sh; runs alone too. The last line is
@@ -54,16 +55,17 @@ check() {
   fi
 }
 
+fuzz_targets=(map_file map_update conversions)
 asan_checks=(asan-core-gtests asan-conversions-gtests asan-concurrency asan-save-sigkill
-             asan-replay-map_file asan-replay-conversions)
+             "${fuzz_targets[@]/#/asan-replay-}")
 if build address g++ test_mvog_core test_mvog_ros_conversions test_concurrency test_save_sigkill \
-  fuzz_replay_map_file fuzz_replay_conversions; then
+  "${fuzz_targets[@]/#/fuzz_replay_}"; then
   dir=$BUILD_ROOT/address/mvog
   check asan-core-gtests "$dir/test_mvog_core"
   check asan-conversions-gtests "$dir/test_mvog_ros_conversions"
   check asan-concurrency "$dir/test_concurrency"
   check asan-save-sigkill "$dir/test_save_sigkill"
-  for target in map_file conversions; do
+  for target in "${fuzz_targets[@]}"; do
     check "asan-replay-$target" "$dir/fuzz_replay_$target" "$REPO/test/fuzz/corpus/$target" \
       "$REPO/test/fuzz/regressions/$target"
   done
@@ -119,8 +121,8 @@ else
   fail "tsan-concurrency: the thread build failed"
 fi
 
-if build fuzz clang++-14 fuzz_map_file fuzz_conversions; then
-  for target in map_file conversions; do
+if build fuzz clang++-14 "${fuzz_targets[@]/#/fuzz_}"; then
+  for target in "${fuzz_targets[@]}"; do
     # New inputs go to the first directory (kept between local runs); the others only seed.
     mkdir -p "$BUILD_ROOT/fuzz/corpus/$target"
     seeds=("$REPO/test/fuzz/corpus/$target")
@@ -130,8 +132,7 @@ if build fuzz clang++-14 fuzz_map_file fuzz_conversions; then
       -artifact_prefix="$FUZZ_LOGS/$target-" "$BUILD_ROOT/fuzz/corpus/$target" "${seeds[@]}"
   done
 else
-  fail "fuzz-map_file: the fuzz build failed"
-  fail "fuzz-conversions: the fuzz build failed"
+  for target in "${fuzz_targets[@]}"; do fail "fuzz-$target: the fuzz build failed"; done
 fi
 
 for failure in "${failures[@]}"; do echo "FAILED: $failure"; done

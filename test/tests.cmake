@@ -37,11 +37,17 @@ else()
 endif()
 
 # ---- The core (include/mvog, src/core) ------------------------------------------------------
+# Some read the recordings in $MVOG_DATA_DIR, else ../shared/data beside the sources, through
+# mvog_bench's scan graph reader (ROS-free).
 mvog_add_gtest(test_mvog_core
   SOURCES test/core/test_volume.cpp test/core/test_raster.cpp test/core/test_insertion.cpp
           test/core/test_queries.cpp test/core/test_map.cpp test/core/test_map_io.cpp
           test/core/test_column.cpp test/core/test_height_colour.cpp
+          test/core/test_lifecycle.cpp test/core/test_merge.cpp test/core/test_map_update.cpp
+          src/tools/bench/scan_graph_input.cpp
   LIBRARIES mvog_core)
+target_include_directories(test_mvog_core PRIVATE src/tools/bench)
+target_compile_definitions(test_mvog_core PRIVATE MVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
 # A process saving maps, killed at random moments: the file always loads (RELIABILITY.md).
 mvog_add_gtest(test_save_sigkill
   SOURCES test/reliability/test_save_sigkill.cpp
@@ -64,9 +70,11 @@ endif()
 if(MVOG_FUZZ_TARGETS)
   add_library(fuzz_map_file_entry OBJECT test/fuzz/fuzz_map_file.cpp)
   target_link_libraries(fuzz_map_file_entry PUBLIC mvog_core)
+  add_library(fuzz_map_update_entry OBJECT test/fuzz/fuzz_map_update.cpp)
+  target_link_libraries(fuzz_map_update_entry PUBLIC mvog_core)
   add_library(fuzz_conversions_entry OBJECT test/fuzz/fuzz_conversions.cpp)
   target_link_libraries(fuzz_conversions_entry PUBLIC mvog_ros_conversions)
-  foreach(target map_file conversions)
+  foreach(target map_file map_update conversions)
     if(MVOG_FUZZ_TARGETS STREQUAL "libfuzzer")
       add_executable(fuzz_${target} $<TARGET_OBJECTS:fuzz_${target}_entry>)
       target_link_libraries(fuzz_${target} fuzz_${target}_entry)

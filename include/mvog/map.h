@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -85,7 +86,7 @@ struct ColumnView {
 /// Memory held by the map.
 struct MemoryUsage {
   /// Bytes the map holds: its tiles, the index of tiles and every cell's volume storage with
-  /// its spare capacity (allocator bookkeeping not included).
+  /// its spare capacity, and its record of removed tiles (allocator bookkeeping not included).
   std::size_t bytes_held = 0;
   /// The paper's Table I accounting: 12 bytes per volume plus an 8-byte reference per cell of
   /// the minimal 2D grid that holds every cell with a volume.
@@ -107,10 +108,39 @@ struct TileIndex {
   }
 };
 
+/// What Map::forget removed.
+struct ForgetResult {
+  std::size_t volumes_removed = 0;  ///< positive volumes and negative volumes (each piece counted)
+  std::size_t cells_emptied = 0;    ///< cells left without a volume, now unknown
+  std::size_t tiles_freed = 0;      ///< tiles left without a cell, their memory released
+};
+
+/// A transform between two maps of one resolution that keeps the grid, so that merging moves
+/// volumes from cell to cell without resampling them (Map::merge): a rotation about z by
+/// quarter_turns x 90 degrees (counter-clockwise), then a translation by whole cells in x and y
+/// and by dz metres in z. A quarter turn takes cell (i, j), the square [i, i + 1) x [j, j + 1),
+/// to the square [-j - 1, -j) x [i, i + 1): cell (-j - 1, i).
+struct GridTransform {
+  int quarter_turns = 0;  ///< any integer; taken modulo 4
+  std::int64_t dx_cells = 0;
+  std::int64_t dy_cells = 0;
+  double dz = 0.0;  ///< metres
+
+  /// The transform `this_from_other` (a homogeneous 4 x 4 matrix, metres) as a GridTransform for
+  /// maps of `resolution`. Throws ConfigError saying why if it is not finite, not rigid, has a
+  /// roll or pitch, a yaw that is no multiple of 90 degrees, or an x or y translation that is no
+  /// whole number of cells (each to within 1e-6 of a cell, or of 1 in the rotation's entries):
+  /// any of those would need the volumes resampled.
+  static GridTransform fromMatrix(const Eigen::Matrix4d& this_from_other, double resolution);
+  /// Where a cell of the other map goes: (x, y), in 64 bits (it may lie beyond any map).
+  std::array<std::int64_t, 2> target(const CellIndex& cell) const;
+};
+
 class ScanUpdate;
 namespace detail {
 class TileBlock;
-}
+struct MapUpdateCodec;
+}  // namespace detail
 
 /// A Multi-Volume Occupancy Grid (Dryanovski, Morris, Xiao, IROS 2010).
 ///
@@ -220,8 +250,47 @@ class Map {
   void setCellVolumes(const std::vector<CellAssignment>& cells);
   void setCellVolumes(const CellIndex& cell, const CellVolumes& volumes);
 
+  // ---- A map's lifetime: forgetting, a local window, clearing, merging ----------------------
+
+  /// Forgetting (after a decay step): removes every positive volume whose real mass is below
+  /// `min_mass`, and every run of touching negative volumes (the pieces of one free volume split
+  /// at obstacles, ModelRules::split_free_space_at_obstacles) whose mass together is below it;
+  /// their space becomes unknown. Negative pieces that touched at a removed positive volume's
+  /// bottom or top are merged again (ListMerger), so every column stays valid. A cell left empty
+  /// is removed, a tile left empty freed. `min_mass` 0 forgets nothing; it must be finite and
+  /// >= 0 (ConfigError). A tile that nothing could have made lighter since the last call costs
+  /// a look at its header: cheap enough for every decay step.
+  ForgetResult forget(double min_mass);
+  /// Removes the tiles wholly farther than `radius` (m) in xy from `centre` and returns them as a
+  /// map of this configuration and mass unit (masses exact), for the caller to save or merge
+  /// elsewhere. Throws ConfigError for a non-finite centre or a NaN or negative radius.
+  Map dropTilesFartherThan(const Eigen::Vector2d& centre, double radius);
+  /// Makes the box [min_corner, max_corner] (m) unknown: in the cells whose squares meet its
+  /// footprint ([floor(s min), ceil(s max)) in x and y), volumes are cut at its bottom and top,
+  /// the parts outside keeping their mass in proportion to their height (parts lower than 1
+  /// go too: Sec. III-A); a column wholly inside is removed. A box lower than one cell's height
+  /// (1 / s) is cleared a little over one cell high around its centre: a column cannot hold a
+  /// gap of 1 or less. Infinite corners are allowed. Returns the number of cells changed.
+  /// Throws ConfigError, changing nothing, for a NaN corner or a box empty or inverted on an axis.
+  std::size_t clearBox(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& max_corner);
+  /// Adds `other` into this map by the constraint application of Sec. III-B.3 (ListMerger, with
+  /// this map's rules, as insertion does): every cell of `other`, moved by `this_from_other`,
+  /// has its lists merged with this map's, overlapping volumes' masses summed (eq. 7), gaps of
+  /// at most 1 closed at density 1 (eq. 8). Masses are brought to this map's unit (exact unless
+  /// this map has decayed: then within a float rounding). Throws ConfigError, changing nothing,
+  /// if the resolutions differ, if the maps count mass differently (ModelRules::mass_counting:
+  /// their masses mean different things), or if a cell would land beyond max_coordinate. Other
+  /// rules may differ: this map's rules shape the merged lists. `other` may be this map.
+  void merge(const Map& other, const GridTransform& this_from_other = {});
+  /// The tiles removed after `revision` (by forget, dropTilesFartherThan, clearBox,
+  /// setCellVolumes, a map update) that do not exist now, rows from the lowest; nothing if the map
+  /// no longer knows (clear() since, or more removals since than it remembers, a bounded number):
+  /// then treat every tile as changed.
+  std::optional<std::vector<TileIndex>> tilesRemovedSince(std::uint64_t revision) const;
+
  private:
   struct Storage;
+  friend struct detail::MapUpdateCodec;  // map_update.cpp: tiles as stored, for exact mirrors
 
   const detail::TileBlock* findTile(std::uint64_t key) const;
   template <class T, class CellValue>

@@ -23,12 +23,6 @@ double splitPowerOfTwo(double x, int& e) {
   return f;
 }
 
-/// When the map's unit exponent falls below this, the exponents are rebased (see Map::decay);
-/// a tile's exponent is kept within kMaxExponentLag of the map's, which changes nothing that a
-/// double can show: 2^-kMaxExponentLag is zero in double.
-constexpr std::int64_t kMinUnitExponent = -(std::int64_t{1} << 24);
-constexpr std::int64_t kMaxExponentLag = std::int64_t{1} << 24;
-
 }  // namespace
 
 InsertionResult& InsertionResult::operator+=(const InsertionResult& other) {
@@ -89,11 +83,7 @@ std::vector<std::uint64_t> Map::sortedTileKeys() const {
   std::vector<std::uint64_t> keys;
   keys.reserve(storage_->tiles.size());
   for (const auto& entry : storage_->tiles) keys.push_back(entry.first);
-  std::sort(keys.begin(), keys.end(), [](std::uint64_t a, std::uint64_t b) {
-    // By (y, x) as signed numbers: rows of tiles from the lowest.
-    const std::int32_t ay = detail::tileKeyY(a), by = detail::tileKeyY(b);
-    return ay != by ? ay < by : detail::tileKeyX(a) < detail::tileKeyX(b);
-  });
+  std::sort(keys.begin(), keys.end(), detail::rowMajorBefore);
   return keys;
 }
 
@@ -101,12 +91,9 @@ void Map::recomputeBounds() {
   bounds_ = kNoCells;
   for (const auto& [key, tile] : storage_->tiles) {
     const CellIndex origin = detail::tileOrigin(key);
-    for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
-      if (tile.holds(local)) {
-        bounds_.extend(CellIndex{origin.x + static_cast<std::int32_t>(local % kTileSize),
-                                 origin.y + static_cast<std::int32_t>(local / kTileSize)});
-      }
-    }
+    const CellRange held = tile.heldCells();
+    bounds_.extend(CellRange{{origin.x + held.min.x, origin.y + held.min.y},
+                             {origin.x + held.max.x, origin.y + held.max.y}});
   }
 }
 
@@ -123,10 +110,12 @@ void Map::decay(double k_d) {
   unit_exponent_ += k_exponent + unit_exponent;
   // After some 2^24 binary orders of decay, move the exponents back near zero so that they stay
   // within 32 bits. No real mass changes that a double can show, and no stored mass changes.
-  if (unit_exponent_ < kMinUnitExponent) {
-    for (auto& entry : storage_->tiles)
-      entry.second.rebaseExponent(unit_exponent_, kMaxExponentLag);
+  if (unit_exponent_ < detail::kMinUnitExponent) {
+    for (auto& entry : storage_->tiles) {
+      entry.second.rebaseExponent(unit_exponent_, detail::kMaxExponentLag);
+    }
     unit_exponent_ = 0;
+    storage_->exponents_rebased_revision = revision_;
   }
 }
 
@@ -147,7 +136,8 @@ MemoryUsage Map::memoryUsage() const {
   const std::size_t tile_index_bytes =
       tiles.bucket_count() * sizeof(void*) +
       tiles.size() * (sizeof(void*) + sizeof(std::uint64_t) + sizeof(detail::TileBlock));
-  usage.bytes_held = sizeof(Map) + sizeof(Storage) + tile_index_bytes + tile_bytes;
+  usage.bytes_held =
+      sizeof(Map) + sizeof(Storage) + tile_index_bytes + tile_bytes + storage_->removals.bytes();
   usage.minimal_grid_cells = static_cast<std::size_t>(bounds_.width() * bounds_.height());
   usage.table_one_bytes = usage.minimal_grid_cells * 8 +
                           (usage.positive_volumes + usage.negative_volumes) * sizeof(Volume);
@@ -160,6 +150,7 @@ void Map::clear() {
   mass_unit_ = 1.0;
   unit_exponent_ = 0;
   ++revision_;
+  storage_->removals.restartAt(revision_);  // the tiles cleared are not listed one by one
 }
 
 std::vector<TileIndex> Map::tilesModifiedSince(std::uint64_t revision) const {
@@ -259,7 +250,7 @@ void Map::setCellVolumes(const std::vector<CellAssignment>& cells) {
     if (!tile.empty()) {
       storage_->tiles[key] = std::move(tile);
     } else if (old != nullptr) {
-      storage_->tiles.erase(existing);
+      storage_->removeTile(existing, revision_);
     }
     first = last;
   }

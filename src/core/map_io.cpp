@@ -11,107 +11,18 @@
 #include <filesystem>
 #include <unordered_set>
 
+#include "byte_format.h"
+
 namespace mvog {
 namespace {
 
 constexpr char kMagic[8] = {'M', 'V', 'O', 'G', 'M', 'A', 'P', '\0'};
-constexpr std::size_t kCellRecordBytes = 16;
-constexpr std::size_t kChecksumBytes = 8;
-
-static_assert(sizeof(float) == 4 && sizeof(double) == 8, "IEEE 754 sizes assumed");
-
-std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
-  std::uint64_t hash = 0xcbf29ce484222325ull;
-  for (std::size_t k = 0; k < size; ++k) {
-    hash ^= data[k];
-    hash *= 0x100000001b3ull;
-  }
-  return hash;
-}
-
-/// Appends values little-endian, whatever the host's byte order.
-class Writer {
- public:
-  explicit Writer(std::vector<std::uint8_t>& out) : out_(out) {}
-  void bytes(const void* data, std::size_t size) {
-    const auto* p = static_cast<const std::uint8_t*>(data);
-    for (std::size_t k = 0; k < size; ++k) out_.push_back(p[k]);
-  }
-  void u32(std::uint32_t v) { unsignedLe(v, 4); }
-  void u64(std::uint64_t v) { unsignedLe(v, 8); }
-  void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
-  void f32(float v) {
-    std::uint32_t bits;
-    std::memcpy(&bits, &v, 4);
-    u32(bits);
-  }
-  void f64(double v) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &v, 8);
-    u64(bits);
-  }
-
- private:
-  void unsignedLe(std::uint64_t v, int size) {
-    for (int k = 0; k < size; ++k) out_.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
-  }
-  std::vector<std::uint8_t>& out_;
-};
-
-/// Reads little-endian values; the caller has checked that they are there.
-class Reader {
- public:
-  Reader(const std::uint8_t* data, std::size_t offset) : data_(data), offset_(offset) {}
-  std::uint32_t u32() { return static_cast<std::uint32_t>(unsignedLe(4)); }
-  std::uint64_t u64() { return unsignedLe(8); }
-  std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
-  float f32() {
-    const std::uint32_t bits = u32();
-    float v;
-    std::memcpy(&v, &bits, 4);
-    return v;
-  }
-  double f64() {
-    const std::uint64_t bits = u64();
-    double v;
-    std::memcpy(&v, &bits, 8);
-    return v;
-  }
-  std::size_t offset() const { return offset_; }
-
- private:
-  std::uint64_t unsignedLe(int size) {
-    std::uint64_t v = 0;
-    for (int k = 0; k < size; ++k) v |= std::uint64_t{data_[offset_ + k]} << (8 * k);
-    offset_ += static_cast<std::size_t>(size);
-    return v;
-  }
-  const std::uint8_t* data_;
-  std::size_t offset_;
-};
+constexpr std::size_t kCellRecordBytes = detail::kCellRecordBytes;
+constexpr std::size_t kChecksumBytes = detail::kChecksumBytes;
+using detail::Reader;
+using detail::Writer;
 
 [[noreturn]] void fail(const std::string& what) { throw MapFileError("invalid map: " + what); }
-
-constexpr std::uint32_t kClipBit = 1u << 0;
-constexpr std::uint32_t kPerScanBit = 1u << 1;
-constexpr std::uint32_t kSplitBit = 1u << 2;
-constexpr std::uint32_t kAllRuleBits = kClipBit | kPerScanBit | kSplitBit;
-
-std::uint32_t rulesBits(const ModelRules& rules) {
-  return (rules.clip_free_space_at_hits ? kClipBit : 0u) |
-         (rules.mass_counting == MassCounting::kPerScan ? kPerScanBit : 0u) |
-         (rules.split_free_space_at_obstacles ? kSplitBit : 0u);
-}
-
-/// Version 1 (no field, zero) is the paper's model.
-ModelRules rulesOf(std::uint32_t bits) {
-  ModelRules rules = ModelRules::paper();
-  rules.clip_free_space_at_hits = (bits & kClipBit) != 0;
-  rules.mass_counting =
-      (bits & kPerScanBit) != 0 ? MassCounting::kPerScan : MassCounting::kPerReading;
-  rules.split_free_space_at_obstacles = (bits & kSplitBit) != 0;
-  return rules;
-}
 
 std::string systemError(const std::string& what, const std::string& path) {
   return what + " '" + path + "': " + std::strerror(errno);
@@ -135,8 +46,8 @@ std::vector<std::uint8_t> serializeMap(const Map& map) {
   });
 
   std::vector<std::uint8_t> out;
-  out.reserve(kMapHeaderBytes + kCellRecordBytes * cells.size() + sizeof(Volume) * volume_count +
-              kChecksumBytes);
+  out.reserve(kMapHeaderBytes + kCellRecordBytes * cells.size() +
+              detail::kVolumeRecordBytes * volume_count + kChecksumBytes);
   Writer writer(out);
   writer.bytes(kMagic, sizeof(kMagic));
   writer.u32(kMapFormatVersion);
@@ -145,23 +56,16 @@ std::vector<std::uint8_t> serializeMap(const Map& map) {
   writer.f64(map.config().max_coordinate);
   writer.u64(cells.size());
   writer.u64(volume_count);
-  writer.u32(rulesBits(map.config().rules));
+  writer.u32(detail::rulesBits(map.config().rules));
   writer.f64(map.config().rules.out_of_range_free_length);
   writer.u32(0);
   for (const CellRecord& record : cells) {
-    writer.i32(record.cell.x);
-    writer.i32(record.cell.y);
-    writer.u32(static_cast<std::uint32_t>(record.volumes.positive.size()));
-    writer.u32(static_cast<std::uint32_t>(record.volumes.negative.size()));
-    for (const std::vector<Volume>* list : {&record.volumes.positive, &record.volumes.negative}) {
-      for (const Volume& v : *list) {
-        writer.f32(v.bottom);
-        writer.f32(v.top);
-        writer.f32(v.mass);
-      }
-    }
+    const CellVolumes& v = record.volumes;
+    detail::writeCell(writer, record.cell, v.positive.data(),
+                      static_cast<std::uint32_t>(v.positive.size()), v.negative.data(),
+                      static_cast<std::uint32_t>(v.negative.size()));
   }
-  writer.u64(fnv1a64(out.data(), out.size()));
+  writer.checksum();
   return out;
 }
 
@@ -183,8 +87,8 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   const std::uint64_t cell_count = header.u64();
   const std::uint64_t volume_count = header.u64();
   const std::uint32_t rules = header.u32();
-  if (rules & ~kAllRuleBits) fail("unknown bits in the model's rules");
-  config.rules = rulesOf(rules);
+  if (rules & ~detail::kAllRuleBits) fail("unknown bits in the model's rules");
+  config.rules = detail::rulesOf(rules);
   if (version == 1) {
     if (header.u64() != 0 || header.u32() != 0) fail("reserved header bytes are not zero");
   } else {
@@ -193,16 +97,13 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   }
   // Check the counts against the real size before trusting them for anything.
   const std::size_t body = size - kMapHeaderBytes - kChecksumBytes;
-  if (cell_count > body / kCellRecordBytes || volume_count > body / sizeof(Volume) ||
-      cell_count * kCellRecordBytes + volume_count * sizeof(Volume) != body) {
+  if (cell_count > body / kCellRecordBytes || volume_count > body / detail::kVolumeRecordBytes ||
+      cell_count * kCellRecordBytes + volume_count * detail::kVolumeRecordBytes != body) {
     fail("the header's counts (" + std::to_string(cell_count) + " cells, " +
          std::to_string(volume_count) + " volumes) do not match the size of " +
          std::to_string(size) + " bytes (truncated or corrupted)");
   }
-  const std::size_t checksum_offset = size - kChecksumBytes;
-  if (Reader(data, checksum_offset).u64() != fnv1a64(data, checksum_offset)) {
-    fail("checksum mismatch (corrupted)");
-  }
+  if (!detail::checksumMatches(data, size)) fail("checksum mismatch (corrupted)");
   Map map = [&] {
     try {
       return Map(config);
@@ -217,27 +118,17 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   std::vector<Map::CellAssignment> assignments;
   assignments.reserve(cell_count);
   for (std::uint64_t c = 0; c < cell_count; ++c) {
-    const CellIndex cell{reader.i32(), reader.i32()};
-    const std::uint64_t num_positive = reader.u32();
-    const std::uint64_t num_negative = reader.u32();
-    const std::string where =
-        "cell (" + std::to_string(cell.x) + ", " + std::to_string(cell.y) + ")";
-    if (num_positive + num_negative == 0) fail(where + " holds no volume");
-    if (volumes_read + num_positive + num_negative > volume_count) {
-      fail(where + " holds more volumes than the header counts");
-    }
+    Map::CellAssignment& assignment = assignments.emplace_back();
+    const std::string problem =
+        detail::readCell(reader, volume_count - volumes_read, assignment.cell, assignment.volumes);
+    if (!problem.empty()) fail(problem);
+    const CellIndex& cell = assignment.cell;
     const std::uint64_t key = (std::uint64_t{static_cast<std::uint32_t>(cell.x)} << 32) |
                               static_cast<std::uint32_t>(cell.y);
-    if (!seen.insert(key).second) fail(where + " appears twice");
-    Map::CellAssignment& assignment = assignments.emplace_back();
-    assignment.cell = cell;
-    CellVolumes& volumes = assignment.volumes;
-    volumes.positive.resize(num_positive);
-    volumes.negative.resize(num_negative);
-    for (std::vector<Volume>* list : {&volumes.positive, &volumes.negative}) {
-      for (Volume& v : *list) v = Volume{reader.f32(), reader.f32(), reader.f32()};
+    if (!seen.insert(key).second) {
+      fail("cell (" + std::to_string(cell.x) + ", " + std::to_string(cell.y) + ") appears twice");
     }
-    volumes_read += num_positive + num_negative;
+    volumes_read += assignment.volumes.positive.size() + assignment.volumes.negative.size();
   }
   if (volumes_read != volume_count) fail("fewer volumes than the header counts");
   try {
@@ -379,6 +270,22 @@ Map loadMap(const std::string& path) {
   } catch (const MapFileError& e) {
     throw MapFileError("'" + path + "': " + e.what());
   }
+}
+
+void mergeIntoMapFile(const Map& part, const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    if (error) throw MapFileError("cannot inspect '" + path + "': " + error.message());
+    saveMap(part, path);
+    return;
+  }
+  Map saved = loadMap(path);
+  try {
+    saved.merge(part);
+  } catch (const ConfigError& e) {
+    throw MapFileError("cannot merge into '" + path + "': " + e.what());
+  }
+  saveMap(saved, path);
 }
 
 }  // namespace mvog

@@ -50,6 +50,22 @@ void TileBlock::scaleMasses(double factor, std::int32_t exponent) {
     all[k].mass = static_cast<float>(all[k].mass * factor);
   }
   block_->exponent = exponent;
+  block_->lightest_mass = kUnknownMass;
+}
+
+CellRange TileBlock::heldCells() const {
+  CellRange held = kNoCells;
+  if (block_ == nullptr) return held;
+  for (int row = 0; row < kTileSize; ++row) {
+    const auto bits = static_cast<std::uint16_t>(block_->occupied[row / 4] >> (16 * (row % 4)));
+    if (bits == 0) continue;
+    int first = 0;
+    while (((bits >> first) & 1u) == 0) ++first;
+    int last = kTileSize - 1;
+    while (((bits >> last) & 1u) == 0) --last;
+    held.extend(CellRange{{first, row}, {last, row}});
+  }
+  return held;
 }
 
 void TileBlock::rebaseExponent(std::int64_t offset, std::int64_t max_lag) {
@@ -101,6 +117,7 @@ TileBlock TileBlock::Builder::finish(std::int32_t exponent, std::uint64_t modifi
     header.num_cells = static_cast<std::uint16_t>(num_cells);
     header.volumes_offset = static_cast<std::uint16_t>(offset);
     header.wide = wide ? 1 : 0;
+    header.lightest_mass = kUnknownMass;
     auto* base = reinterpret_cast<unsigned char*>(tile.block_ + 1);
     starts_.push_back(num_volumes);
     for (std::uint32_t r = 0; r < num_cells; ++r) {
@@ -136,6 +153,37 @@ TileBlock TileBlock::Builder::finish(std::int32_t exponent, std::uint64_t modifi
   num_positive_.clear();
   volumes_.clear();
   return tile;
+}
+
+void TileBlock::Rewrite::clear() {
+  cells_.clear();
+  volumes_.clear();
+}
+
+void TileBlock::Rewrite::set(unsigned local, const std::vector<Volume>& positive,
+                             const std::vector<Volume>& negative) {
+  cells_.push_back({local, volumes_.size(), static_cast<std::uint32_t>(positive.size()),
+                    static_cast<std::uint32_t>(negative.size())});
+  volumes_.insert(volumes_.end(), positive.begin(), positive.end());
+  volumes_.insert(volumes_.end(), negative.begin(), negative.end());
+}
+
+TileBlock TileBlock::Rewrite::apply(const TileBlock& tile, std::int32_t exponent,
+                                    std::uint64_t modified_revision) {
+  auto cell = cells_.begin();
+  for (unsigned local = 0; local < kCellsPerTile; ++local) {
+    if (cell != cells_.end() && cell->local == local) {
+      if (cell->num_positive + cell->num_negative > 0) {
+        const Volume* v = volumes_.data() + cell->start;
+        builder_.add(local, {v, cell->num_positive, v + cell->num_positive, cell->num_negative},
+                     1.0);
+      }
+      ++cell;
+    } else if (tile.holds(local)) {
+      builder_.add(local, tile.column(local), 1.0);
+    }
+  }
+  return builder_.finish(exponent, modified_revision);
 }
 
 }  // namespace detail

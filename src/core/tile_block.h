@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "mvog/cell_index.h"
@@ -37,6 +38,11 @@ inline std::int32_t tileKeyX(std::uint64_t key) { return static_cast<std::int32_
 inline std::int32_t tileKeyY(std::uint64_t key) { return static_cast<std::int32_t>(key); }
 inline std::uint64_t tileKeyOf(const CellIndex& c) {
   return tileKey(c.x >> kTileSizeLog2, c.y >> kTileSizeLog2);  // arithmetic shifts floor
+}
+/// The order of tiles in listings and files: by (y, x) as signed numbers, rows from the lowest.
+inline bool rowMajorBefore(std::uint64_t a, std::uint64_t b) {
+  const std::int32_t ay = tileKeyY(a), by = tileKeyY(b);
+  return ay != by ? ay < by : tileKeyX(a) < tileKeyX(b);
 }
 inline CellIndex tileOrigin(std::uint64_t key) {
   return {tileKeyX(key) * kTileSize, tileKeyY(key) * kTileSize};
@@ -84,15 +90,27 @@ class TileBlock {
 
   /// The map's mass exponent when the tile was written (see Map::decay).
   std::int32_t exponent() const { return block_ == nullptr ? 0 : block_->exponent; }
-  /// The map revision at which a volume of the tile last changed.
-  std::uint64_t modifiedRevision() const {
-    return block_ == nullptr ? 0 : block_->modified_revision;
-  }
+  /// The map revision at which a volume of the tile last changed. Whoever changes volumes in place
+  /// sets it afterwards, which also forgets cachedLightestMass.
+  std::uint64_t modifiedRevision() const { return block_ == nullptr ? 0 : block_->modified_revision; }
   void setModifiedRevision(std::uint64_t revision) {
-    if (block_ != nullptr) block_->modified_revision = revision;
+    if (block_ == nullptr) return;
+    block_->modified_revision = revision;
+    block_->lightest_mass = kUnknownMass;
   }
   /// Multiplies every mass by `factor` and takes `exponent` (after a decay step, Map::decay).
   void scaleMasses(double factor, std::int32_t exponent);
+  /// What Map::forget last found to be the tile's lightest mass (stored unit), NaN if the tile
+  /// changed since: a tile whose lightest mass is above the threshold is skipped without a look
+  /// at its volumes.
+  float cachedLightestMass() const {
+    return block_ == nullptr ? kUnknownMass : block_->lightest_mass;
+  }
+  void cacheLightestMass(float mass) {
+    if (block_ != nullptr) block_->lightest_mass = mass;
+  }
+  /// The cells holding volumes, in tile-local coordinates (0 to kTileSize - 1); empty if none.
+  CellRange heldCells() const;
   /// Moves the exponent by -offset, clamped so it stays within 32 bits (Map::decay's rebase).
   void rebaseExponent(std::int64_t offset, std::int64_t max_lag);
 
@@ -113,6 +131,31 @@ class TileBlock {
     std::vector<Volume> volumes_;
   };
 
+  /// New lists for some cells of a tile, gathered cell by cell, then the tile built anew with
+  /// them and its other cells copied.
+  class Rewrite {
+   public:
+    void clear();
+    /// The new lists of cell `local` (both empty: the cell goes), in increasing local index.
+    void set(unsigned local, const std::vector<Volume>& positive,
+             const std::vector<Volume>& negative);
+    bool empty() const { return cells_.empty(); }
+    /// `tile` with the cells set replaced (empty if no cell is left).
+    TileBlock apply(const TileBlock& tile, std::int32_t exponent, std::uint64_t modified_revision);
+
+   private:
+    /// Cell `local`'s new lists: volumes_[start, start + num_positive), then its negative ones.
+    struct Cell {
+      unsigned local;
+      std::size_t start;
+      std::uint32_t num_positive;
+      std::uint32_t num_negative;
+    };
+    std::vector<Cell> cells_;
+    std::vector<Volume> volumes_;
+    Builder builder_;
+  };
+
  private:
   struct Header {
     std::uint64_t occupied[kCellsPerTile / 64];  // bit k: cell k holds a volume
@@ -125,8 +168,10 @@ class TileBlock {
     /// Cells holding volumes in the bitmap's words before words 1, 2 and 3: a rank is then one
     /// word's count.
     std::uint8_t words_before[kCellsPerTile / 64 - 1];
+    float lightest_mass;  // see cachedLightestMass
   };
-  static_assert(sizeof(Header) == 56, "the header fills its 8-byte alignment exactly");
+  static_assert(sizeof(Header) == 64, "the header fills one cache line");
+  static constexpr float kUnknownMass = std::numeric_limits<float>::quiet_NaN();
   /// Rank of cell `local` among the cells with volumes (its bit must be set).
   unsigned rank(unsigned local) const;
   std::uint32_t start(unsigned rank) const;

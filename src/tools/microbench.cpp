@@ -1,5 +1,5 @@
 // Google Benchmark micro-benchmarks of the MVOG core (no ROS): one reading, one ~25k-point depth
-// scan, 100k point queries, a 20 m x 20 m cross-section, a decay step, save and load.
+// scan, 100k point queries, a 20 m x 20 m cross-section, a decay step, forgetting, save and load.
 // The scene is a 10 m x 8 m x 3 m room holding two spheres, seen by a 176 x 144 depth camera
 // (the paper's SwissRanger) from 12 poses; the map is at 0.05 m. See BENCHMARKS.md.
 #include <cmath>
@@ -140,6 +140,49 @@ void BM_DecayRenormalise(benchmark::State& state) {
   for (auto _ : state) map.decay(0x1p-65);
 }
 BENCHMARK(BM_DecayRenormalise)->Unit(benchmark::kMillisecond);
+
+/// `rooms` x `rooms` copies of the room map side by side (Map::merge): a large map.
+mvog::Map roomsMap(int rooms) {
+  const mvog::Map& room = sharedRoomMap();
+  mvog::Map map(room.config());
+  const std::int64_t cells = static_cast<std::int64_t>(std::lround(12.0 / kResolution));
+  for (int i = 0; i < rooms; ++i) {
+    for (int j = 0; j < rooms; ++j)
+      map.merge(room, mvog::GridTransform{0, i * cells, j * cells, 0.0});
+  }
+  return map;
+}
+
+/// Forgetting what is lighter than 1e-6 (not inlined: callgrind --toggle-collect='*forgetStep*'
+/// counts the benchmarks' steps alone, without their set-up).
+[[gnu::noinline]] mvog::ForgetResult forgetStep(mvog::Map& map) { return map.forget(1e-6); }
+
+/// A decay step and forgetting, with nothing light enough to forget: what forgetting costs on
+/// every decay step of a large map (each tile's lightest mass is remembered from the last call).
+void BM_DecayAndForgetNothing(benchmark::State& state) {
+  mvog::Map map = roomsMap(static_cast<int>(state.range(0)));
+  map.forget(1e-6);
+  for (auto _ : state) {
+    map.decay(0.999999);
+    benchmark::DoNotOptimize(forgetStep(map));
+  }
+  state.counters["tiles"] = static_cast<double>(map.memoryUsage().tiles);
+}
+BENCHMARK(BM_DecayAndForgetNothing)->Arg(1)->Arg(5)->Unit(benchmark::kMicrosecond);
+
+/// Forgetting after a scan: the tiles the scan wrote are looked at again.
+void BM_ScanThenForget(benchmark::State& state) {
+  mvog::Map map = roomsMap(5);
+  map.forget(1e-6);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    map.insertScan(roomScans()[k++ % roomScans().size()], insertionConfig(1));
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(forgetStep(map));
+  }
+}
+BENCHMARK(BM_ScanThenForget)->Unit(benchmark::kMicrosecond);
 
 void BM_Save(benchmark::State& state) {
   const mvog::Map& map = sharedRoomMap();

@@ -2,6 +2,8 @@
 """Writes the seed corpora of the fuzz targets (test/fuzz/corpus/<target>/), deterministically.
 
 map_file: maps in the format of include/mvog/map_io.h (valid ones, and a few refused ones).
+map_update: map updates in the format of include/mvog/map_io.h, of the small map that
+fuzz_map_update.cpp's mirrors start from (valid ones, and a few refused ones).
 conversions: inputs in the layout documented at the top of test/fuzz/fuzz_conversions.cpp.
 Run it again after changing either format; the files are small and committed.
 """
@@ -31,6 +33,27 @@ def map_file(cells, resolution=0.1, max_coordinate=10000.0, version=1):
         out += struct.pack('<iiII', x, y, len(positive), len(negative))
         for bottom, top, mass in positive + negative:
             out += struct.pack('<fff', bottom, top, mass)
+    return out + struct.pack('<Q', fnv1a64(out))
+
+
+def map_update(tiles, removed=(), full=False, source=1, from_revision=0, to_revision=1,
+               mass_unit=1.0, unit_exponent=0, resolution=1.0, max_coordinate=1000.0, rules=7,
+               out_of_range_free_length=2.0):
+    """tiles: [(tile_x, tile_y, exponent, [(x, y, [(bottom, top, mass)...positive], [...])])]"""
+    cells = sum(len(c) for _, _, _, c in tiles)
+    volumes = sum(len(p) + len(n) for _, _, _, c in tiles for _, _, p, n in c)
+    out = b'MVOGUPD\0' + struct.pack('<IIddIdIQQQdqQQQQQ', 1, 128, resolution, max_coordinate,
+                                      rules, out_of_range_free_length, 1 if full else 0, source,
+                                      from_revision, to_revision, mass_unit, unit_exponent,
+                                      len(removed), len(tiles), cells, volumes, 0)
+    for tile_x, tile_y in removed:
+        out += struct.pack('<ii', tile_x, tile_y)
+    for tile_x, tile_y, exponent, tile_cells in tiles:
+        out += struct.pack('<iiiI', tile_x, tile_y, exponent, len(tile_cells))
+        for x, y, positive, negative in tile_cells:
+            out += struct.pack('<iiII', x, y, len(positive), len(negative))
+            for bottom, top, mass in positive + negative:
+                out += struct.pack('<fff', bottom, top, mass)
     return out + struct.pack('<Q', fnv1a64(out))
 
 
@@ -95,6 +118,32 @@ def main():
     }
     for name, data in maps.items():
         with open(os.path.join(HERE, 'corpus', 'map_file', name), 'wb') as f:
+            f.write(data)
+
+    # The small map of fuzz_map_update.cpp, at revision 5, then what changed after.
+    small_tiles = [(0, 0, 0, [(3, 4, [(0.0, 1.0, 2.0)], [(-4.0, -1.0, 3.0)]),
+                              (5, 4, [], [(2.0, 5.0, 3.0)])]),
+                   (1, 0, 0, [(17, 0, [(1.0, 2.0, 1.0)], [])]),
+                   (-1, 2, 0, [(-3, 40, [(0.0, 2.0, 2.0)], [])])]
+    changed = [(0, 0, 0, [(3, 4, [(0.0, 1.0, 4.0)], [(-4.0, -1.0, 3.0)]),
+                          (5, 4, [], [(2.0, 5.0, 3.0)])])]
+    many = [(3.0 * k, 3.0 * k + 1.0, 1.0) for k in range(300)]  # a tile of wide counts
+    updates = {
+        'full.mvogupd': map_update(small_tiles, full=True, to_revision=5),
+        'removed_and_changed.mvogupd': map_update(changed, removed=[(1, 0)], from_revision=5,
+                                                  to_revision=7, mass_unit=0.75),
+        'decay_only.mvogupd': map_update([], from_revision=7, to_revision=8, mass_unit=0.625,
+                                         unit_exponent=-3),
+        'wide_tile.mvogupd': map_update([(2, 2, 0, [(33, 40, many, [(-9.0, -2.0, 7.0)])])],
+                                        from_revision=5, to_revision=9),
+        'extreme_exponents.mvogupd': map_update([(0, 0, 1 << 24, [(1, 1, [(0.0, 1.0, 3e38)], [])])],
+                                                from_revision=5, to_revision=10,
+                                                unit_exponent=-(1 << 24)),
+        'refused_checksum.mvogupd': map_update(changed, from_revision=5, to_revision=6)[:-1] + b'\0',
+        'refused_map_file.mvogupd': map_file([(0, 0, [(0.0, 1.0, 1.0)], [])]),
+    }
+    for name, data in updates.items():
+        with open(os.path.join(HERE, 'corpus', 'map_update', name), 'wb') as f:
             f.write(data)
 
     far = 1e7  # 10,000 km
