@@ -92,7 +92,9 @@ class TileBlock {
   std::int32_t exponent() const { return block_ == nullptr ? 0 : block_->exponent; }
   /// The map revision at which a volume of the tile last changed. Whoever changes volumes in place
   /// sets it afterwards, which also forgets cachedLightestMass.
-  std::uint64_t modifiedRevision() const { return block_ == nullptr ? 0 : block_->modified_revision; }
+  std::uint64_t modifiedRevision() const {
+    return block_ == nullptr ? 0 : block_->modified_revision;
+  }
   void setModifiedRevision(std::uint64_t revision) {
     if (block_ == nullptr) return;
     block_->modified_revision = revision;
