@@ -1,0 +1,299 @@
+// Segment and box checks (mvog/checks.h): each column's runs of one state intersected with the
+// heights the query spans over that column.
+#include "mvog/checks.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "capsule.h"
+#include "column_runs.h"
+#include "mvog/raster.h"
+
+namespace mvog {
+namespace {
+
+using detail::AlignedBox;
+using detail::Extent;
+using detail::StateRun;
+using detail::worse;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::array<const Eigen::Vector3d*, 2> pointsOf(const Segment& segment) {
+  return {&segment.start, &segment.end};
+}
+std::array<const Eigen::Vector3d*, 2> pointsOf(const Box& box) { return {&box.min, &box.max}; }
+
+/// Validates `config` and each query, and adds up the cells the queries visit (prepare(query)
+/// returns a query's). Refuses, before any work, a query with a point that is not finite or lies
+/// beyond the map's max_coordinate (beyond it nothing can be known, and cell indices would
+/// overflow), and more cells in all than max_query_cells.
+template <class Query, class Prepare>
+void requireQueries(const Map& map, const PlanningConfig& config, const std::vector<Query>& queries,
+                    const char* what, Prepare&& prepare) {
+  config.validate();
+  std::int64_t cells = 0;
+  for (std::size_t k = 0; k < queries.size(); ++k) {
+    for (const Eigen::Vector3d* point : pointsOf(queries[k])) {
+      if (!point->allFinite() || point->cwiseAbs().maxCoeff() > map.config().max_coordinate) {
+        throw ConfigError(std::string(what) + " " + std::to_string(k) +
+                          ": a point is not finite or lies beyond the map's max_coordinate");
+      }
+    }
+    cells += prepare(queries[k]);
+    if (cells > config.max_query_cells) {
+      throw ConfigError("max_query_cells: the queries cover " + std::to_string(cells) +
+                        " cells, more than " + std::to_string(config.max_query_cells));
+    }
+  }
+}
+
+/// The range of t in [0, 1] over which start + t delta lies within [low, high] along `axis`.
+std::optional<Extent> slab(const Eigen::Vector3d& start, const Eigen::Vector3d& delta, int axis,
+                           double low, double high) {
+  if (delta[axis] == 0.0) {
+    if (start[axis] < low || start[axis] > high) return std::nullopt;
+    return Extent{0.0, 1.0};
+  }
+  double t_low = (low - start[axis]) / delta[axis];
+  double t_high = (high - start[axis]) / delta[axis];
+  if (t_low > t_high) std::swap(t_low, t_high);
+  t_low = std::max(t_low, 0.0);
+  t_high = std::min(t_high, 1.0);
+  if (t_low > t_high) return std::nullopt;
+  return Extent{t_low, t_high};
+}
+
+std::int32_t floorCell(double grid_coordinate) {
+  return static_cast<std::int32_t>(std::floor(grid_coordinate));
+}
+
+/// One segment in grid units, checked cell by cell.
+class SegmentWalk {
+ public:
+  SegmentWalk(const Map& map, const Segment& segment, double radius, double threshold,
+              detail::ColumnScratch& scratch)
+      : map_(map),
+        threshold_(threshold),
+        scratch_(scratch),
+        start_(segment.start / map.resolution()),
+        delta_((segment.end - segment.start) / map.resolution()),
+        radius_(radius / map.resolution()),
+        length_((segment.end - segment.start).norm()) {}
+
+  /// The cells the check visits (exactly those of check()).
+  std::int64_t cells() const {
+    if (radius_ == 0.0) {
+      const CellIndex a = cellAt(start_.x(), start_.y());
+      const CellIndex b = cellAt(start_.x() + delta_.x(), start_.y() + delta_.y());
+      return std::abs(std::int64_t{b.x} - a.x) + std::abs(std::int64_t{b.y} - a.y) + 1;
+    }
+    std::int64_t count = 0;
+    forEachRow([&](std::int32_t, std::int32_t first, std::int32_t last, const Extent&) {
+      count += std::int64_t{last} - first + 1;
+    });
+    return count;
+  }
+
+  SegmentCheck check() {
+    if (radius_ == 0.0) {
+      walkRay(start_.x(), start_.y(), start_.z(), start_.x() + delta_.x(), start_.y() + delta_.y(),
+              start_.z() + delta_.z(),
+              [&](const CellIndex& cell, double z_enter, double z_exit, bool) {
+                visitCrossedCell(cell, z_enter, z_exit);
+              });
+    } else {
+      const detail::Capsule capsule(start_, start_ + delta_, radius_);
+      forEachRow([&](std::int32_t y, std::int32_t first, std::int32_t last, const Extent& row) {
+        const bool forward = delta_.x() >= 0.0;  // cells in the order the segment meets them
+        for (std::int32_t k = 0; k <= last - first; ++k) {
+          visitSweptCell(capsule, {forward ? first + k : last - k, y}, row);
+        }
+      });
+    }
+    SegmentCheck result;
+    result.state = state_;
+    if (state_ != OccupancyState::kFree) result.blocked_at = blocked_t_ * length_;
+    return result;
+  }
+
+ private:
+  /// Calls visit(y, first x, last x, range of t) for each row of cells over which some point
+  /// within the radius may lie, in the order the segment meets them: the cells over which the
+  /// segment passes within the radius along x and along y (a superset of the capsule's footprint,
+  /// refined per cell).
+  template <class Visit>
+  void forEachRow(Visit&& visit) const {
+    const double y0 = std::min(start_.y(), start_.y() + delta_.y()) - radius_;
+    const double y1 = std::max(start_.y(), start_.y() + delta_.y()) + radius_;
+    const std::int32_t low = floorCell(y0);
+    const std::int32_t high = floorCell(y1);
+    const bool forward = delta_.y() >= 0.0;
+    for (std::int32_t k = 0; k <= high - low; ++k) {
+      const std::int32_t y = forward ? low + k : high - k;
+      const std::optional<Extent> row = slab(start_, delta_, 1, y - radius_, y + 1 + radius_);
+      if (!row) continue;
+      const double x_a = start_.x() + row->min * delta_.x();
+      const double x_b = start_.x() + row->max * delta_.x();
+      visit(y, floorCell(std::min(x_a, x_b) - radius_), floorCell(std::max(x_a, x_b) + radius_),
+            *row);
+    }
+  }
+
+  /// Radius 0: the segment crosses the column from height z_enter to z_exit (walkRay's order is
+  /// the segment's, so the first blocked cell holds the first blocked point).
+  void visitCrossedCell(const CellIndex& cell, double z_enter, double z_exit) {
+    if (state_ == OccupancyState::kOccupied) return;  // nothing left to learn
+    const double low = std::min(z_enter, z_exit);
+    const double high = std::max(z_enter, z_exit);
+    const OccupancyState state =
+        detail::stateOver(map_.column(cell), low, high, threshold_, scratch_);
+    if (state == OccupancyState::kFree) return;
+    if (state_ == OccupancyState::kFree) blocked_t_ = firstBlockedInCell(cell, z_enter, z_exit);
+    state_ = worse(state_, state);
+  }
+
+  /// Where the segment first meets a run that is not free in `cell`, whose runs are in scratch_.
+  double firstBlockedInCell(const CellIndex& cell, double z_enter, double z_exit) const {
+    const bool upwards = z_exit >= z_enter;
+    const double low = std::min(z_enter, z_exit);
+    const double high = std::max(z_enter, z_exit);
+    double z_first = upwards ? kInf : -kInf;
+    for (const StateRun& run : scratch_.runs) {
+      if (run.state == OccupancyState::kFree || !run.meets(low, high)) continue;
+      z_first = upwards ? std::min<double>(z_first, std::max<double>(z_enter, run.bottom))
+                        : std::max<double>(z_first, std::min<double>(z_enter, run.top));
+    }
+    // The t at which the segment enters the cell: the later of its entries along x and y.
+    double t_enter = 0.0;
+    for (int axis = 0; axis < 2; ++axis) {
+      if (delta_[axis] == 0.0) continue;
+      const double wall = (axis == 0 ? cell.x : cell.y) + (delta_[axis] > 0.0 ? 0.0 : 1.0);
+      t_enter = std::max(t_enter, (wall - start_[axis]) / delta_[axis]);
+    }
+    if (z_first == z_enter) return t_enter;
+    return std::clamp((z_first - start_.z()) / delta_.z(), t_enter, 1.0);
+  }
+
+  /// Radius > 0: `cell` of a row over which the segment passes within the radius along y for t
+  /// in `row`.
+  void visitSweptCell(const detail::Capsule& capsule, const CellIndex& cell, const Extent& row) {
+    const std::optional<Extent> along_x =
+        slab(start_, delta_, 0, cell.x - radius_, cell.x + 1 + radius_);
+    if (!along_x) return;
+    const double t_low = std::max(row.min, along_x->min);
+    const double t_high = std::min(row.max, along_x->max);
+    if (t_low > t_high) return;
+    const bool could_block_earlier = t_low < blocked_t_;
+    if (state_ == OccupancyState::kOccupied && !could_block_earlier) return;
+    // First with the heights the sphere spans while over the cell's neighbourhood (a superset),
+    // then, unless that is free, with the heights the capsule spans over the cell itself.
+    const double z_a = start_.z() + t_low * delta_.z();
+    const double z_b = start_.z() + t_high * delta_.z();
+    const ColumnView column = map_.column(cell);
+    if (detail::stateOver(column, std::min(z_a, z_b) - radius_, std::max(z_a, z_b) + radius_,
+                          threshold_, scratch_) == OccupancyState::kFree) {
+      return;
+    }
+    const AlignedBox square{{double(cell.x), double(cell.y), -kInf},
+                            {cell.x + 1.0, cell.y + 1.0, kInf}};
+    const std::optional<Extent> heights = capsule.extent(2, square, 0b011u);
+    if (!heights) return;
+    const OccupancyState state =
+        detail::stateOver(column, heights->min, heights->max, threshold_, scratch_);
+    if (state == OccupancyState::kFree) return;
+    state_ = worse(state_, state);
+    if (!could_block_earlier) return;
+    for (const StateRun& run : scratch_.runs) {
+      if (run.state == OccupancyState::kFree || !run.meets(heights->min, heights->max)) continue;
+      const AlignedBox box{{double(cell.x), double(cell.y), run.bottom},
+                           {cell.x + 1.0, cell.y + 1.0, run.top}};
+      // A run the capsule meets is touched at some t; rounding at a tangency may lose it, and
+      // then the cell's first possible t stands in for it (earlier: on the safe side).
+      blocked_t_ = std::min(blocked_t_, capsule.firstContact(box).value_or(t_low));
+    }
+  }
+
+  const Map& map_;
+  const double threshold_;
+  detail::ColumnScratch& scratch_;
+  const Eigen::Vector3d start_;  // grid units
+  const Eigen::Vector3d delta_;  // end - start, grid units
+  const double radius_;          // grid units
+  const double length_;          // m
+  OccupancyState state_ = OccupancyState::kFree;
+  double blocked_t_ = kInf;  // t of the first point met that is not free
+};
+
+}  // namespace
+
+std::vector<SegmentCheck> checkSegments(const Map& map, const std::vector<Segment>& segments,
+                                        double radius, const PlanningConfig& config) {
+  if (!(std::isfinite(radius) && radius >= 0.0)) {
+    throw ConfigError("radius: must be a finite number >= 0");
+  }
+  detail::ColumnScratch scratch;
+  std::vector<SegmentWalk> walks;
+  walks.reserve(segments.size());
+  requireQueries(map, config, segments, "segment", [&](const Segment& segment) {
+    walks.emplace_back(map, segment, radius, config.occupancy_threshold, scratch);
+    return walks.back().cells();
+  });
+  std::vector<SegmentCheck> results;
+  results.reserve(segments.size());
+  for (SegmentWalk& walk : walks) results.push_back(walk.check());
+  return results;
+}
+
+std::vector<BoxCheck> checkBoxes(const Map& map, const std::vector<Box>& boxes,
+                                 const PlanningConfig& config) {
+  std::vector<CellRange> footprints;
+  footprints.reserve(boxes.size());
+  requireQueries(map, config, boxes, "box", [&](const Box& box) {
+    if ((box.min.array() > box.max.array()).any()) {
+      throw ConfigError("box " + std::to_string(footprints.size()) +
+                        ": min lies above max along an axis");
+    }
+    footprints.push_back(map.cellsInRectangle(box.min.x(), box.min.y(), box.max.x(), box.max.y()));
+    return footprints.back().width() * footprints.back().height();
+  });
+  detail::ColumnScratch scratch;
+  std::vector<BoxCheck> results;
+  results.reserve(boxes.size());
+  for (std::size_t k = 0; k < boxes.size(); ++k) {
+    const Eigen::Vector3d min = boxes[k].min / map.resolution();
+    const Eigen::Vector3d max = boxes[k].max / map.resolution();
+    const double box_volume = (max - min).prod();
+    OccupancyState state = OccupancyState::kFree;
+    double known_volume = 0.0;
+    float max_probability = -1.0f;
+    const CellRange& footprint = footprints[k];
+    for (std::int32_t y = footprint.min.y; y <= footprint.max.y; ++y) {
+      for (std::int32_t x = footprint.min.x; x <= footprint.max.x; ++x) {
+        // The box's corners belong to it: a cell it only touches counts for the state.
+        const double area = (std::min(max.x(), x + 1.0) - std::max(min.x(), double(x))) *
+                            (std::min(max.y(), y + 1.0) - std::max(min.y(), double(y)));
+        detail::stateRuns(map.column({x, y}), config.occupancy_threshold, scratch);
+        state = worse(state, detail::stateOver(scratch.runs, min.z(), max.z()));
+        for (const ColumnSegment& segment : scratch.profile) {
+          if (segment.bottom > max.z() || segment.top < min.z()) continue;
+          max_probability = std::max(max_probability, segment.probability);
+          known_volume += area * (std::min<double>(max.z(), segment.top) -
+                                  std::max<double>(min.z(), segment.bottom));
+        }
+      }
+    }
+    BoxCheck result;
+    result.state = state;
+    result.known_fraction =
+        box_volume > 0.0 ? known_volume / box_volume : std::numeric_limits<double>::quiet_NaN();
+    if (max_probability >= 0.0f) result.max_probability = max_probability;
+    results.push_back(result);
+  }
+  return results;
+}
+
+}  // namespace mvog

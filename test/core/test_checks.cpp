@@ -1,0 +1,223 @@
+// Segment and box checks (mvog/checks.h) on the room of planning_scene.h, and the column profile
+// they are built on.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "mvog/checks.h"
+#include "mvog/column.h"
+#include "planning_scene.h"
+#include "test_util.h"
+
+namespace mvog {
+namespace {
+
+constexpr double kCell = test::kSceneResolution;
+
+SegmentCheck checkOne(const Map& map, const Eigen::Vector3d& start, const Eigen::Vector3d& end,
+                      double radius) {
+  return checkSegments(map, {{start, end}}, radius).at(0);
+}
+
+BoxCheck checkOne(const Map& map, const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
+  return checkBoxes(map, {{min, max}}).at(0);
+}
+
+// ---- The column profile over a stored column
+// -------------------------------------------------
+
+TEST(ColumnProfile, FromTheStoredColumnEqualsTheCopiedOneAndEquation9) {
+  const Map map = test::randomMap(5, 0.1, 3.0);
+  std::vector<ColumnSegment> stored;
+  std::size_t columns = 0;
+  for (const CellIndex& cell : test::observedCells(map)) {
+    columnProfile(map.column(cell), stored);
+    const std::vector<ColumnSegment> copied = columnProfile(map.cellVolumes(cell));
+    ASSERT_EQ(stored.size(), copied.size());
+    for (std::size_t k = 0; k < stored.size(); ++k) {
+      EXPECT_EQ(stored[k].bottom, copied[k].bottom);
+      EXPECT_EQ(stored[k].top, copied[k].top);
+      EXPECT_EQ(stored[k].probability, copied[k].probability);
+      // Eq. (9) at the middle of each segment, through the map's own point query.
+      const double middle = 0.5 * (stored[k].bottom + stored[k].top) * 0.1;
+      const PointOccupancy p = map.occupancy({(cell.x + 0.5) * 0.1, (cell.y + 0.5) * 0.1, middle});
+      ASSERT_TRUE(p.known());
+      EXPECT_FLOAT_EQ(*p.probability, stored[k].probability);
+    }
+    ++columns;
+  }
+  EXPECT_GT(columns, 1000u);
+}
+
+// ---- Segments
+// ---------------------------------------------------------------------------------
+
+TEST(SegmentChecks, ThroughAWallIsOccupiedAtTheWallsDistance) {
+  const Map map = test::sceneMap();
+  // The wall x = 4.0 lies 2.0 m from the start.
+  const SegmentCheck check = checkOne(map, {2.0, 0.55, 1.0}, {4.5, 0.55, 1.0}, 0.0);
+  EXPECT_EQ(check.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(check.blocked_at, 2.0, 1e-9);
+  // Slanted, and downwards into the floor: 1 m along x, falling 1 m, meets z = 0 at sqrt(2).
+  const SegmentCheck floor = checkOne(map, {0.5, 2.25, 1.0}, {1.5, 2.25, 0.0}, 0.0);
+  EXPECT_EQ(floor.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(floor.blocked_at, std::sqrt(2.0), 1e-9);
+}
+
+TEST(SegmentChecks, ThroughTheOpenRoomIsFree) {
+  const Map map = test::sceneMap();
+  for (double radius : {0.0, 0.1, 0.3}) {
+    // Diagonal over the desk (its top is 0.8 m), below the ceiling (2.5 m), clear of the pillar.
+    const SegmentCheck check = checkOne(map, {0.5, 0.4, 1.2}, {3.5, 1.5, 1.5}, radius);
+    EXPECT_EQ(check.state, OccupancyState::kFree) << "radius " << radius;
+    EXPECT_TRUE(std::isnan(check.blocked_at));
+  }
+  // A segment of one point.
+  EXPECT_EQ(checkOne(map, {2.5, 2.5, 1.0}, {2.5, 2.5, 1.0}, 0.0).state, OccupancyState::kFree);
+  EXPECT_EQ(checkOne(map, {2.5, 2.5, 1.0}, {2.5, 2.5, 1.0}, 0.2).state, OccupancyState::kFree);
+}
+
+TEST(SegmentChecks, IntoNeverSeenSpaceIsUnknown) {
+  const Map map = test::sceneMap();
+  // Beyond y = 3.0 nothing was observed.
+  SegmentCheck check = checkOne(map, {2.5, 2.5, 1.0}, {2.5, 3.5, 1.0}, 0.0);
+  EXPECT_EQ(check.state, OccupancyState::kUnknown);
+  EXPECT_NEAR(check.blocked_at, 0.5, 1e-9);
+  // Through the door: free in the door's cells, unknown from x = 4.1 on.
+  check = checkOne(map, {3.5, 1.45, 1.0}, {4.5, 1.45, 1.0}, 0.0);
+  EXPECT_EQ(check.state, OccupancyState::kUnknown);
+  EXPECT_NEAR(check.blocked_at, 0.6, 1e-9);
+  // Up through the ceiling into the unknown above it: occupied wins over unknown, and the
+  // first blocked point is the ceiling's bottom.
+  check = checkOne(map, {2.5, 2.5, 1.0}, {2.5, 2.5, 3.0}, 0.0);
+  EXPECT_EQ(check.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(check.blocked_at, 1.5, 1e-9);
+}
+
+TEST(SegmentChecks, AGrazedFaceIsOccupied) {
+  // At exactly the floor's top the segment touches the obstacle's face: the height belongs to
+  // both the floor and the free space above it.
+  const Map map = test::sceneMap();
+  EXPECT_EQ(checkOne(map, {0.5, 2.5, 0.0}, {3.5, 2.5, 0.0}, 0.0).state, OccupancyState::kOccupied);
+  EXPECT_EQ(checkOne(map, {0.5, 2.5, 0.01}, {3.5, 2.5, 0.01}, 0.0).state, OccupancyState::kFree);
+}
+
+TEST(SegmentChecks, ARadiusCatchesAWallTheBareSegmentMisses) {
+  const Map map = test::sceneMap();
+  // Towards the wall x = 4.0, stopping 0.15 m before it.
+  const Eigen::Vector3d start(3.0, 0.55, 1.0);
+  const Eigen::Vector3d end(3.85, 0.55, 1.0);
+  EXPECT_EQ(checkOne(map, start, end, 0.0).state, OccupancyState::kFree);
+  EXPECT_EQ(checkOne(map, start, end, 0.14).state, OccupancyState::kFree);
+  const SegmentCheck check = checkOne(map, start, end, 0.2);
+  EXPECT_EQ(check.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(check.blocked_at, 0.8, 1e-9);  // the sphere's centre at x = 3.8
+  // Over the floor: the sphere reaches down to the floor's top.
+  EXPECT_EQ(checkOne(map, {0.5, 2.5, 0.35}, {1.5, 2.5, 0.35}, 0.3).state, OccupancyState::kFree);
+  const SegmentCheck low = checkOne(map, {0.5, 2.5, 0.35}, {1.5, 2.5, 0.25}, 0.3);
+  EXPECT_EQ(low.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(low.blocked_at, 0.5 * std::hypot(1.0, 0.1), 1e-9);  // where z = 0.3
+}
+
+TEST(SegmentChecks, TheSweptSphereIsRoundAtAnObstaclesEdge) {
+  // Along y = 1.8, passing the pillar's face y = 2.0 at 0.2 m: with a radius of 0.21 the sphere
+  // first meets its edge at x = 3.0 when (3.0 - x)^2 + 0.2^2 = 0.21^2.
+  const Map map = test::sceneMap();
+  const Eigen::Vector3d start(2.0, 1.8, 1.0);
+  const Eigen::Vector3d end(3.5, 1.8, 1.0);
+  EXPECT_EQ(checkOne(map, start, end, 0.19).state, OccupancyState::kFree);
+  const SegmentCheck check = checkOne(map, start, end, 0.21);
+  EXPECT_EQ(check.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(check.blocked_at, 1.0 - std::sqrt(0.21 * 0.21 - 0.2 * 0.2), 1e-9);
+  // Along y = 0.3 at z = 1.0, beside and above the desk's board (y from 0.5, top at 0.8): the
+  // sphere first meets the board's corner (1.0, 0.5, 0.8) when (1.0 - x)^2 + 0.2^2 + 0.2^2 =
+  // r^2, and misses it below r = sqrt(0.08).
+  EXPECT_EQ(checkOne(map, {0.5, 0.3, 1.0}, {1.5, 0.3, 1.0}, 0.28).state, OccupancyState::kFree);
+  const SegmentCheck corner = checkOne(map, {0.5, 0.3, 1.0}, {1.5, 0.3, 1.0}, 0.29);
+  EXPECT_EQ(corner.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(corner.blocked_at, 0.5 - std::sqrt(0.29 * 0.29 - 0.08), 1e-9);
+}
+
+TEST(SegmentChecks, BoundsTheWorkAndRefusesBadInput) {
+  const Map map = test::sceneMap();
+  PlanningConfig config;
+  config.max_query_cells = 100;
+  // 41 cells along x.
+  EXPECT_NO_THROW(checkSegments(map, {{{0.05, 0.5, 1.0}, {4.05, 0.5, 1.0}}}, 0.0, config));
+  EXPECT_NO_THROW(checkSegments(
+      map, {{{0.05, 0.5, 1.0}, {4.05, 0.5, 1.0}}, {{0.05, 0.5, 1.0}, {4.05, 0.5, 1.0}}}, 0.0,
+      config));
+  try {
+    checkSegments(map, std::vector<Segment>(3, Segment{{0.05, 0.5, 1.0}, {4.05, 0.5, 1.0}}), 0.0,
+                  config);
+    FAIL() << "not refused";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("max_query_cells"), std::string::npos) << e.what();
+  }
+  // With a radius the footprint is wider: 41 x 5 cells and more.
+  EXPECT_THROW(checkSegments(map, {{{0.05, 0.5, 1.0}, {4.05, 0.5, 1.0}}}, 0.2, config),
+               ConfigError);
+  EXPECT_THROW(checkSegments(map, {{{0, 0, 0}, {1, 1, 1}}}, -0.1), ConfigError);
+  EXPECT_THROW(checkSegments(map, {{{0, 0, 0}, {1, 1, 1}}}, NAN), ConfigError);
+  EXPECT_THROW(checkSegments(map, {{{0, NAN, 0}, {1, 1, 1}}}, 0.0), ConfigError);
+  EXPECT_THROW(checkSegments(map, {{{0, 0, 0}, {1e5, 1, 1}}}, 0.0), ConfigError);
+  PlanningConfig bad;
+  bad.occupancy_threshold = 1.0;
+  EXPECT_THROW(checkSegments(map, {}, 0.0, bad), ConfigError);
+  EXPECT_TRUE(checkSegments(map, {}, 0.0).empty());
+}
+
+// ---- Boxes
+// ------------------------------------------------------------------------------------
+
+TEST(BoxChecks, ABoxOnTheDeskIsOccupied) {
+  const Map map = test::sceneMap();
+  const BoxCheck check = checkOne(map, {1.2, 0.7, 0.75}, {1.5, 1.0, 1.0});
+  EXPECT_EQ(check.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(check.known_fraction, 1.0, 1e-12);
+  EXPECT_NEAR(check.max_probability, 5.0 / 5.1, 1e-6);  // the board: rho+ 5, rho- 0.1
+}
+
+TEST(BoxChecks, ABoxInTheAirIsFree) {
+  const Map map = test::sceneMap();
+  const BoxCheck check = checkOne(map, {2.5, 2.0, 1.0}, {2.9, 2.5, 1.5});
+  EXPECT_EQ(check.state, OccupancyState::kFree);
+  EXPECT_NEAR(check.known_fraction, 1.0, 1e-12);
+  EXPECT_EQ(check.max_probability, 0.0);
+}
+
+TEST(BoxChecks, AHalfSeenBoxIsHalfKnown) {
+  const Map map = test::sceneMap();
+  // y in [2.8, 3.2]: known up to y = 3.0.
+  const BoxCheck check = checkOne(map, {1.0, 2.8, 1.0}, {1.5, 3.2, 1.5});
+  EXPECT_EQ(check.state, OccupancyState::kUnknown);
+  EXPECT_NEAR(check.known_fraction, 0.5, 1e-9);
+  EXPECT_EQ(check.max_probability, 0.0);
+  // Nothing known at all.
+  const BoxCheck unseen = checkOne(map, {1.0, 5.0, 1.0}, {1.5, 5.5, 1.5});
+  EXPECT_EQ(unseen.state, OccupancyState::kUnknown);
+  EXPECT_EQ(unseen.known_fraction, 0.0);
+  EXPECT_TRUE(std::isnan(unseen.max_probability));
+  // Through the ceiling: the unknown above it makes it unknown and occupied: occupied.
+  const BoxCheck ceiling = checkOne(map, {1.0, 2.0, 2.4}, {1.5, 2.5, 2.8});
+  EXPECT_EQ(ceiling.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(ceiling.known_fraction, 0.5, 1e-6);  // [2.4, 2.6] of [2.4, 2.8]
+  EXPECT_EQ(ceiling.max_probability, 1.0f);
+}
+
+TEST(BoxChecks, AFlatBoxHasNoKnownFractionAndTheLimitHolds) {
+  const Map map = test::sceneMap();
+  const BoxCheck flat = checkOne(map, {1.2, 0.7, 0.75}, {1.5, 1.0, 0.75});
+  EXPECT_EQ(flat.state, OccupancyState::kOccupied);
+  EXPECT_TRUE(std::isnan(flat.known_fraction));
+  PlanningConfig config;
+  config.max_query_cells = 10;
+  EXPECT_THROW(checkBoxes(map, {{{0, 0, 0}, {1, 1, 1}}}, config), ConfigError);
+  EXPECT_THROW(checkBoxes(map, {{{0, 0, 0}, {-1, 1, 1}}}), ConfigError);
+  EXPECT_THROW(checkBoxes(map, {{{0, 0, 0}, {INFINITY, 1, 1}}}), ConfigError);
+}
+
+}  // namespace
+}  // namespace mvog
