@@ -59,5 +59,17 @@ OccupancyState stateOver(const ColumnView& column, double low, double high, doub
   return stateOver(scratch.runs, low, high);
 }
 
+void RunsOfCells::compute(const Map& map, const CellRange& cells, double threshold) {
+  cells_ = cells;
+  runs_.resize(static_cast<std::size_t>(cells.width() * cells.height()));
+  std::size_t k = 0;
+  for (std::int32_t y = cells.min.y; y <= cells.max.y; ++y) {
+    for (std::int32_t x = cells.min.x; x <= cells.max.x; ++x) {
+      columnProfile(map.column({x, y}), profile_);
+      stateRuns(profile_, threshold, runs_[k++]);
+    }
+  }
+}
+
 }  // namespace detail
 }  // namespace mvog

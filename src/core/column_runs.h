@@ -58,5 +58,24 @@ OccupancyState stateOver(const std::vector<StateRun>& runs, double low, double h
 OccupancyState stateOver(const ColumnView& column, double low, double high, double threshold,
                          ColumnScratch& scratch);
 
+/// The runs of every column of a rectangle of cells, each computed once, for results that look at
+/// a cell's neighbours.
+class RunsOfCells {
+ public:
+  /// Computes the runs of every column of `cells` (its buffers are kept from call to call).
+  void compute(const Map& map, const CellRange& cells, double threshold);
+  /// The runs of a cell of the rectangle.
+  const std::vector<StateRun>& at(const CellIndex& cell) const {
+    return runs_[static_cast<std::size_t>(cell.y - cells_.min.y) *
+                     static_cast<std::size_t>(cells_.width()) +
+                 static_cast<std::size_t>(cell.x - cells_.min.x)];
+  }
+
+ private:
+  CellRange cells_ = kNoCells;
+  std::vector<std::vector<StateRun>> runs_;
+  std::vector<ColumnSegment> profile_;
+};
+
 }  // namespace detail
 }  // namespace mvog

@@ -88,11 +88,11 @@ inline Map sceneMap() {
 // ---- The same kind of room, scanned -------------------------------------------------------
 //
 // A room x, y in [-3, 3] x [-2, 2], floor at z = 0, ceiling at 2.5, walls 0.2 m thick, a door in
-// the wall x = 3 (y in [-0.4, 0.4], up to z = 2.0) opening onto a wall at x = 5; a table (top
-// over z in [0.7, 0.75], x in [0.5, 1.5], y in [-1.5, -0.5], on four legs) and a cabinet (x in
-// [-2.5, -2.0], y in [1.0, 1.8], up to z = 1.2). Mapped with insertScan at 0.1 m from four poses
-// at z = 1.2, each a sphere of rays every 2 degrees; rays meeting nothing within 8 m are
-// out-of-range readings.
+// the wall x = 3 (y in [-0.4, 0.4], up to z = 2.0) opening onto a floor up to a wall at x = 5;
+// a table (top over z in [0.7, 0.75], x in [0.5, 1.5], y in [-1.5, -0.5], on four legs) and a
+// cabinet (x in [-2.5, -2.0], y in [1.0, 1.8], up to z = 1.2). Mapped with insertScan at 0.1 m
+// from four poses at z = 1.2 and one at 0.4 that sees under the table, each a sphere of rays
+// every 2 degrees; rays meeting nothing within 8 m are out-of-range readings.
 
 struct SolidBox {
   Eigen::Vector3d min;
@@ -107,11 +107,15 @@ inline std::vector<SolidBox> scannedRoomSolids() {
       {{-3.2, -2.2, 0.0}, {3.2, -2.0, 2.5}},  // wall y = -2
       {{-3.2, 2.0, 0.0}, {3.2, 2.2, 2.5}},    // wall y = 2
       {{3.0, -2.2, 0.0}, {3.2, -0.4, 2.5}},   // wall x = 3, beside the door
-      {{3.0, 0.4, 0.0}, {3.2, 2.2, 2.5}},     {{3.0, -0.4, 2.0}, {3.2, 0.4, 2.5}},  // the lintel
-      {{5.0, -3.0, -0.2}, {5.2, 3.0, 2.5}},   // the wall beyond the door
+      {{3.0, 0.4, 0.0}, {3.2, 2.2, 2.5}},
+      {{3.0, -0.4, 2.0}, {3.2, 0.4, 2.5}},   // the lintel
+      {{5.0, -3.0, -0.2}, {5.2, 3.0, 2.5}},  // the wall beyond the door, and the floor there
+      {{3.2, -3.0, -0.2}, {5.0, 3.0, 0.0}},
       {{0.5, -1.5, 0.7}, {1.5, -0.5, 0.75}},  // the table's top and legs
-      {{0.5, -1.5, 0.0}, {0.55, -1.45, 0.7}}, {{1.45, -1.5, 0.0}, {1.5, -1.45, 0.7}},
-      {{0.5, -0.55, 0.0}, {0.55, -0.5, 0.7}}, {{1.45, -0.55, 0.0}, {1.5, -0.5, 0.7}},
+      {{0.5, -1.5, 0.0}, {0.55, -1.45, 0.7}},
+      {{1.45, -1.5, 0.0}, {1.5, -1.45, 0.7}},
+      {{0.5, -0.55, 0.0}, {0.55, -0.5, 0.7}},
+      {{1.45, -0.55, 0.0}, {1.5, -0.5, 0.7}},
       {{-2.5, 1.0, 0.0}, {-2.0, 1.8, 1.2}},  // the cabinet
   };
 }
@@ -144,7 +148,7 @@ inline Map scannedRoomMap() {
   Map map(config);
   constexpr double kMaxRange = 8.0;
   const Eigen::Vector3d poses[] = {
-      {-1.5, 0.0, 1.2}, {1.5, 0.8, 1.2}, {0.0, -1.0, 1.2}, {2.0, -1.2, 1.2}};
+      {-1.5, 0.0, 1.2}, {1.5, 0.8, 1.2}, {0.0, -1.0, 1.2}, {2.0, -1.2, 1.2}, {2.3, -1.0, 0.4}};
   for (const Eigen::Vector3d& origin : poses) {
     Scan scan;
     scan.origin = origin;

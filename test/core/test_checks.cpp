@@ -14,8 +14,6 @@
 namespace mvog {
 namespace {
 
-constexpr double kCell = test::kSceneResolution;
-
 SegmentCheck checkOne(const Map& map, const Eigen::Vector3d& start, const Eigen::Vector3d& end,
                       double radius) {
   return checkSegments(map, {{start, end}}, radius).at(0);
