@@ -1,6 +1,7 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -57,6 +58,34 @@ struct BoxCheck {
 /// than config.max_query_cells cells in all (then before any work).
 std::vector<SegmentCheck> checkSegments(const Map& map, const std::vector<Segment>& segments,
                                         double radius, const PlanningConfig& config = {});
+
+namespace detail {
+class BlockSummaries;
+}
+
+/// Checks segments as checkSegments does, keeping from call to call what it found about blocks of
+/// 4 x 4 cells (the heights at which all are known free, those at which some is occupied),
+/// forgotten for the tiles that change: repeated checks on a map pass open and unknown space
+/// without looking at each of its columns.
+/// Not thread-safe: one call at a time. After the map is replaced by another one (loaded, reset),
+/// call clear(): revisions of two maps say nothing about each other.
+class SegmentChecker {
+ public:
+  /// Throws ConfigError if `config` is invalid.
+  explicit SegmentChecker(const PlanningConfig& config = {});
+  ~SegmentChecker();
+  SegmentChecker(SegmentChecker&&) noexcept;
+  SegmentChecker& operator=(SegmentChecker&&) noexcept;
+
+  /// See checkSegments.
+  std::vector<SegmentCheck> check(const Map& map, const std::vector<Segment>& segments,
+                                  double radius);
+  void clear();
+
+ private:
+  PlanningConfig config_;
+  std::unique_ptr<detail::BlockSummaries> blocks_;
+};
 
 /// Checks axis-aligned boxes against the map's volumes exactly: each cell the box lies over,
 /// weighted by the area the box covers of it, with the column's lists over the box's heights.

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "mvog/checks.h"
@@ -165,6 +166,57 @@ TEST(SegmentChecks, BoundsTheWorkAndRefusesBadInput) {
   bad.occupancy_threshold = 1.0;
   EXPECT_THROW(checkSegments(map, {}, 0.0, bad), ConfigError);
   EXPECT_TRUE(checkSegments(map, {}, 0.0).empty());
+}
+
+TEST(SegmentChecks, ACheckerKeptAcrossChangesOfTheMapAnswersAsAFreshCheck) {
+  Map map = test::sceneMap();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> x(0.2, 3.8);
+  std::uniform_real_distribution<double> y(0.2, 2.8);
+  std::uniform_real_distribution<double> z(0.3, 2.2);
+  std::vector<Segment> segments;
+  for (int k = 0; k < 300; ++k)
+    segments.push_back({{x(rng), y(rng), z(rng)}, {x(rng), y(rng), z(rng)}});
+  auto same = [&](SegmentChecker& checker, double radius) {
+    const std::vector<SegmentCheck> kept = checker.check(map, segments, radius);
+    const std::vector<SegmentCheck> fresh = checkSegments(map, segments, radius);
+    std::size_t free = 0;
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      if (kept[k].state != fresh[k].state ||
+          !(kept[k].blocked_at == fresh[k].blocked_at ||
+            (std::isnan(kept[k].blocked_at) && std::isnan(fresh[k].blocked_at)))) {
+        return ::testing::AssertionFailure() << "segment " << k << " differs";
+      }
+      free += fresh[k].state == OccupancyState::kFree;
+    }
+    if (free == 0 || free == segments.size()) {
+      return ::testing::AssertionFailure() << free << " free: the test shows nothing";
+    }
+    return ::testing::AssertionSuccess();
+  };
+  for (double radius : {0.0, 0.2}) {
+    SegmentChecker checker;
+    EXPECT_TRUE(same(checker, radius));
+    // An obstacle in open space: a column of the room occupied from floor to ceiling.
+    std::vector<Map::CellAssignment> pillars;
+    for (int cell_y = 2; cell_y < 28; cell_y += 3)
+      pillars.push_back({{25, cell_y}, test::wallColumn()});
+    map.setCellVolumes(pillars);
+    EXPECT_TRUE(same(checker, radius));
+    // A whole tile emptied (the map removes it): unknown space where the checker saw free space.
+    std::vector<Map::CellAssignment> emptied;
+    for (int cell_y = 16; cell_y < 30; ++cell_y) {
+      for (int cell_x = 0; cell_x < 16; ++cell_x) emptied.push_back({{cell_x, cell_y}, {}});
+    }
+    map.setCellVolumes(emptied);
+    EXPECT_TRUE(same(checker, radius));
+    // Scans, which change many tiles; then another map altogether.
+    map.insertScan(test::randomScan(rng, {2.0, 1.5, 1.0}, 200, 100, 2.0));
+    EXPECT_TRUE(same(checker, radius));
+    map = test::sceneMap();
+    checker.clear();
+    EXPECT_TRUE(same(checker, radius));
+  }
 }
 
 // ---- Boxes
