@@ -139,6 +139,22 @@ TEST(SegmentChecks, TheSweptSphereIsRoundAtAnObstaclesEdge) {
   EXPECT_NEAR(corner.blocked_at, 0.5 - std::sqrt(0.29 * 0.29 - 0.08), 1e-9);
 }
 
+TEST(SegmentChecks, InAScannedRoom) {
+  const Map map = test::scannedRoomMap();
+  // Through the wall x = -3 (hits on its face make its cell occupied: x in [-3.0, -2.9)).
+  const SegmentCheck wall = checkOne(map, {0.0, 0.2, 1.2}, {-4.0, 0.2, 1.2}, 0.0);
+  EXPECT_EQ(wall.state, OccupancyState::kOccupied);
+  EXPECT_NEAR(wall.blocked_at, 3.0, test::kSceneResolution + 1e-9);  // 2.9: that cell entered
+  // From one pose to another.
+  EXPECT_EQ(checkOne(map, {-1.5, 0.0, 1.2}, {1.5, 0.8, 1.2}, 0.0).state, OccupancyState::kFree);
+  // Up beyond the door, where the rays through it did not reach.
+  EXPECT_EQ(checkOne(map, {4.0, 0.0, 1.0}, {4.0, 0.0, 3.5}, 0.0).state, OccupancyState::kUnknown);
+  // Along the wall y = -2, 0.2 m from it: a radius of 0.25 m meets it.
+  EXPECT_EQ(checkOne(map, {-1.0, -1.8, 1.2}, {-0.5, -1.8, 1.2}, 0.0).state, OccupancyState::kFree);
+  EXPECT_EQ(checkOne(map, {-1.0, -1.8, 1.2}, {-0.5, -1.8, 1.2}, 0.25).state,
+            OccupancyState::kOccupied);
+}
+
 TEST(SegmentChecks, BoundsTheWorkAndRefusesBadInput) {
   const Map map = test::sceneMap();
   PlanningConfig config;
