@@ -238,39 +238,46 @@ TEST(SegmentChecks, ACheckerKeptAcrossChangesOfTheMapAnswersAsAFreshCheck) {
 // ---- Boxes
 // ------------------------------------------------------------------------------------
 
+/// The box check found `state`, and known_fraction and max_probability within 1e-6 (NaN: NaN).
+::testing::AssertionResult boxIs(const BoxCheck& check, OccupancyState state, double known_fraction,
+                                 double max_probability) {
+  auto near = [](double a, double b) {
+    return std::isnan(a) ? std::isnan(b) : std::abs(a - b) <= 1e-6;
+  };
+  if (check.state == state && near(check.known_fraction, known_fraction) &&
+      near(check.max_probability, max_probability)) {
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure()
+         << "state " << int(check.state) << ", known_fraction " << check.known_fraction
+         << ", max_probability " << check.max_probability;
+}
+
 TEST(BoxChecks, ABoxOnTheDeskIsOccupied) {
   const Map map = test::sceneMap();
-  const BoxCheck check = checkOne(map, {1.2, 0.7, 0.75}, {1.5, 1.0, 1.0});
-  EXPECT_EQ(check.state, OccupancyState::kOccupied);
-  EXPECT_NEAR(check.known_fraction, 1.0, 1e-12);
-  EXPECT_NEAR(check.max_probability, 5.0 / 5.1, 1e-6);  // the board: rho+ 5, rho- 0.1
+  // The board: rho+ 5, rho- 0.1.
+  EXPECT_TRUE(boxIs(checkOne(map, {1.2, 0.7, 0.75}, {1.5, 1.0, 1.0}), OccupancyState::kOccupied,
+                    1.0, 5.0 / 5.1));
 }
 
 TEST(BoxChecks, ABoxInTheAirIsFree) {
   const Map map = test::sceneMap();
-  const BoxCheck check = checkOne(map, {2.5, 2.0, 1.0}, {2.9, 2.5, 1.5});
-  EXPECT_EQ(check.state, OccupancyState::kFree);
-  EXPECT_NEAR(check.known_fraction, 1.0, 1e-12);
-  EXPECT_EQ(check.max_probability, 0.0);
+  EXPECT_TRUE(
+      boxIs(checkOne(map, {2.5, 2.0, 1.0}, {2.9, 2.5, 1.5}), OccupancyState::kFree, 1.0, 0.0));
 }
 
 TEST(BoxChecks, AHalfSeenBoxIsHalfKnown) {
   const Map map = test::sceneMap();
   // y in [2.8, 3.2]: known up to y = 3.0.
-  const BoxCheck check = checkOne(map, {1.0, 2.8, 1.0}, {1.5, 3.2, 1.5});
-  EXPECT_EQ(check.state, OccupancyState::kUnknown);
-  EXPECT_NEAR(check.known_fraction, 0.5, 1e-9);
-  EXPECT_EQ(check.max_probability, 0.0);
+  EXPECT_TRUE(
+      boxIs(checkOne(map, {1.0, 2.8, 1.0}, {1.5, 3.2, 1.5}), OccupancyState::kUnknown, 0.5, 0.0));
   // Nothing known at all.
-  const BoxCheck unseen = checkOne(map, {1.0, 5.0, 1.0}, {1.5, 5.5, 1.5});
-  EXPECT_EQ(unseen.state, OccupancyState::kUnknown);
-  EXPECT_EQ(unseen.known_fraction, 0.0);
-  EXPECT_TRUE(std::isnan(unseen.max_probability));
-  // Through the ceiling: the unknown above it makes it unknown and occupied: occupied.
-  const BoxCheck ceiling = checkOne(map, {1.0, 2.0, 2.4}, {1.5, 2.5, 2.8});
-  EXPECT_EQ(ceiling.state, OccupancyState::kOccupied);
-  EXPECT_NEAR(ceiling.known_fraction, 0.5, 1e-6);  // [2.4, 2.6] of [2.4, 2.8]
-  EXPECT_EQ(ceiling.max_probability, 1.0f);
+  EXPECT_TRUE(
+      boxIs(checkOne(map, {1.0, 5.0, 1.0}, {1.5, 5.5, 1.5}), OccupancyState::kUnknown, 0.0, NAN));
+  // Through the ceiling into the unknown above it: occupied wins; known over [2.4, 2.6] of
+  // [2.4, 2.8].
+  EXPECT_TRUE(
+      boxIs(checkOne(map, {1.0, 2.0, 2.4}, {1.5, 2.5, 2.8}), OccupancyState::kOccupied, 0.5, 1.0));
 }
 
 TEST(BoxChecks, AFlatBoxHasNoKnownFractionAndTheLimitHolds) {
