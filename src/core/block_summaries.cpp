@@ -64,7 +64,13 @@ BlockSummaries::Summary BlockSummaries::summarise(std::int32_t block_x, std::int
       stateRuns(map_->column({x, y}), threshold_, scratch_);
       // The free stretches of the first column, cut down to those of the others.
       kept.clear();
+      CellFree& cell =
+          summary.cells[static_cast<unsigned>(((y & kBlockMask) << kBlockLog2) | (x & kBlockMask))];
       for (const StateRun& run : scratch_.runs) {
+        if (run.state == OccupancyState::kFree && cell.count < 2) {
+          cell.bottom[cell.count] = run.bottom;
+          cell.top[cell.count++] = run.top;
+        }
         if (run.state == OccupancyState::kOccupied) {
           if (!summary.occupied) summary.occupied = Extent{run.bottom, run.top};
           summary.occupied->min = std::min<double>(summary.occupied->min, run.bottom);

@@ -41,6 +41,17 @@ class BlockSummaries {
     }
     return false;
   }
+  /// The same for one cell: whether [low, high] lies strictly within one of the cell's two
+  /// lowest free stretches (false tells nothing).
+  bool cellFreeOver(const CellIndex& cell, double low, double high) {
+    const CellFree& free = summary(cell.x >> kBlockLog2, cell.y >> kBlockLog2)
+                               .cells[static_cast<unsigned>(((cell.y & kBlockMask) << kBlockLog2) |
+                                                            (cell.x & kBlockMask))];
+    for (int k = 0; k < free.count; ++k) {
+      if (free.bottom[k] < low && high < free.top[k]) return true;
+    }
+    return false;
+  }
   /// Whether some cell of block (x, y) may be occupied at some height of [low, high] (false: no
   /// cell is).
   bool mayBeOccupiedOver(std::int32_t x, std::int32_t y, double low, double high) {
@@ -49,13 +60,22 @@ class BlockSummaries {
   }
 
  private:
+  static constexpr std::int32_t kBlockMask = kBlockSize - 1;
   static constexpr int kPerTileLog2 = Map::kTileSizeLog2 - kBlockLog2;  // blocks along an edge
   static constexpr std::size_t kBlocksPerTile = std::size_t{1} << (2 * kPerTileLog2);
-  static constexpr std::size_t kMaxTiles = std::size_t{1} << 14;
+  /// Some 6 kB each: at most some 25 MB kept from call to call.
+  static constexpr std::size_t kMaxTiles = std::size_t{1} << 12;
 
+  /// A cell's two lowest free stretches.
+  struct CellFree {
+    float bottom[2];
+    float top[2];
+    int count = 0;
+  };
   struct Summary {
     std::vector<Extent> free;        ///< heights where every cell is free, the faces excluded
     std::optional<Extent> occupied;  ///< from the lowest to the highest occupied height of a cell
+    std::array<CellFree, kBlockSize * kBlockSize> cells;  ///< row by row
   };
   /// The blocks of one tile.
   struct TileBlocks {

@@ -182,7 +182,7 @@ class SegmentWalk {
     const double high = std::max(z_enter, z_exit);
     const std::int32_t block_x = cell.x >> Blocks::kBlockLog2;
     const std::int32_t block_y = cell.y >> Blocks::kBlockLog2;
-    if (context_.blocks.freeOver(block_x, block_y, low, high)) return;
+    if (context_.blocks.cellFreeOver(cell, low, high)) return;
     // Once unknown space was met, the first blocked point is known: only an occupied one matters.
     if (state_ == OccupancyState::kUnknown &&
         !context_.blocks.mayBeOccupiedOver(block_x, block_y, low, high)) {
@@ -274,6 +274,7 @@ class SegmentWalk {
     // First with the heights the sphere spans while near the cell (a superset), then, unless that
     // tells nothing, with the heights the capsule spans over the cell itself.
     const Extent near = sweptHeights(*t);
+    if (context_.blocks.cellFreeOver(cell, near.min, near.max)) return;
     const OccupancyState near_state = detail::stateOver(
         context_.map.column(cell), near.min, near.max, context_.threshold, context_.scratch);
     if (near_state == OccupancyState::kFree) return;
