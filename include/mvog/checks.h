@@ -45,13 +45,15 @@ struct BoxCheck {
   double max_probability = std::numeric_limits<double>::quiet_NaN();
 };
 
-/// Checks segments against the map's volumes exactly, not by sampling points: in each cell that
-/// the segment's xy-projection crosses (walkRay), or that a point within `radius` (m) of the
-/// segment lies over, the column's lists are intersected with the heights the segment (or the
-/// space within the radius of it) spans in that column. Decision where the paper is silent: a
-/// height where two known stretches of different states meet counts as both (eq. 9 at that one
-/// height comes from one of the two touching volumes), so a segment grazing an obstacle's face
-/// is occupied.
+/// Checks segments against the map's volumes exactly, not by sampling points. Radius 0: in each
+/// cell that the segment's xy-projection crosses (walkRay), the column's stretches of one state
+/// are intersected with the heights the segment spans there. Radius > 0 (m): in each cell that a
+/// point within the radius may lie over, each occupied or unknown stretch of the column within
+/// the heights the sphere spans near it is the box it fills over the cell, and where the sphere
+/// swept along the segment first meets that box is solved exactly (touching a face counts).
+/// Decision where the paper is silent: a height where two known stretches of different states
+/// meet counts as both (eq. 9 at that one height comes from one of the two touching volumes), so
+/// a segment grazing an obstacle's face is occupied.
 ///
 /// Throws ConfigError, naming the field, if `config` or `radius` is invalid, if a segment has a
 /// point that is not finite or lies beyond the map's max_coordinate, or if the segments cover more

@@ -15,7 +15,7 @@ struct AlignedBox {
   Eigen::Vector3d max;
 };
 
-/// The range of values a coordinate takes over a set of points.
+/// A range of values.
 struct Extent {
   double min = 0.0;
   double max = 0.0;
@@ -23,9 +23,9 @@ struct Extent {
 
 /// The points within `radius` (> 0) of the segment P(t) = start + t (end - start), t in [0, 1].
 ///
-/// Both questions reduce to the squared distance from P(t) to a box, which is a sum over the
-/// axes of squared clamped differences: a quadratic in t between the (at most six) values of t
-/// where P(t) crosses a face's plane. Each question is then solved exactly on each piece.
+/// Where it first meets a box follows from the squared distance from P(t) to the box, a sum over
+/// the axes of squared clamped differences: a quadratic in t between the (at most six) values of
+/// t where P(t) crosses a face's plane, solved exactly on each piece.
 class Capsule {
  public:
   Capsule(const Eigen::Vector3d& start, const Eigen::Vector3d& end, double radius)
@@ -33,9 +33,6 @@ class Capsule {
 
   /// The smallest t at which the sphere around P(t) meets `box`, if it ever does.
   std::optional<double> firstContact(const AlignedBox& box) const;
-  /// The range of coordinate `axis` over the capsule's points whose coordinates along the axes
-  /// of `bounded` (bit k: axis k; not `axis` itself) lie within `box`; nothing if no point does.
-  std::optional<Extent> extent(int axis, const AlignedBox& box, unsigned bounded) const;
 
  private:
   /// q(t) = a t^2 + b t + c over [t0, t1].
@@ -43,9 +40,9 @@ class Capsule {
     double t0, t1, a, b, c;
   };
   static constexpr int kMaxPieces = 7;
-  /// The squared distance from P(t) to `box` along the axes of `bounded`, piece by piece in
-  /// increasing t; returns the number of pieces.
-  int squaredDistance(const AlignedBox& box, unsigned bounded, Piece* pieces) const;
+  /// The squared distance from P(t) to `box`, piece by piece in increasing t; returns the number
+  /// of pieces.
+  int squaredDistance(const AlignedBox& box, Piece* pieces) const;
   /// The part of the piece where q(t) <= radius^2, if any.
   std::optional<Extent> within(const Piece& piece) const;
 

@@ -279,22 +279,17 @@ class SegmentWalk {
         context_.map.column(cell), near.min, near.max, context_.threshold, context_.scratch);
     if (near_state == OccupancyState::kFree) return;
     if (!could_block_earlier && near_state != OccupancyState::kOccupied) return;
-    const AlignedBox square{{double(cell.x), double(cell.y), -kInf},
-                            {cell.x + 1.0, cell.y + 1.0, kInf}};
-    const std::optional<Extent> heights = capsule.extent(2, square, 0b011u);
-    if (!heights) return;
-    const std::vector<StateRun>& runs = context_.scratch.runs;  // filled: near_state is not free
-    const OccupancyState state = detail::stateOver(runs, heights->min, heights->max);
-    if (state == OccupancyState::kFree) return;
-    state_ = worse(state_, state);
-    if (!could_block_earlier) return;
-    for (const StateRun& run : runs) {
-      if (run.state == OccupancyState::kFree || !run.meets(heights->min, heights->max)) continue;
+    // Each stretch that is not free within those heights, exactly: where the sphere first meets
+    // the box it fills over the cell, if ever (for unknown space, the box's faces included).
+    for (const StateRun& run : context_.scratch.runs) {  // filled: near_state is not free
+      if (run.state == OccupancyState::kFree || !run.meets(near.min, near.max)) continue;
+      if (!could_block_earlier && run.state != OccupancyState::kOccupied) continue;
       const AlignedBox box{{double(cell.x), double(cell.y), run.bottom},
                            {cell.x + 1.0, cell.y + 1.0, run.top}};
-      // A run the capsule meets is touched at some t; rounding at a tangency may lose it, and
-      // then the cell's first possible t stands in for it (earlier: on the safe side).
-      blocked_t_ = std::min(blocked_t_, capsule.firstContact(box).value_or(t->min));
+      const std::optional<double> contact = capsule.firstContact(box);
+      if (!contact) continue;
+      state_ = worse(state_, run.state);
+      blocked_t_ = std::min(blocked_t_, *contact);
     }
   }
 
