@@ -44,6 +44,8 @@ mvog_add_gtest(test_mvog_core
           test/core/test_queries.cpp test/core/test_map.cpp test/core/test_map_io.cpp
           test/core/test_column.cpp test/core/test_height_colour.cpp
           test/core/test_lifecycle.cpp test/core/test_merge.cpp test/core/test_map_update.cpp
+          test/core/test_checks.cpp test/core/test_segment_property.cpp
+          test/core/test_frontiers.cpp test/core/test_surfaces.cpp
           src/tools/bench/scan_graph_input.cpp
   LIBRARIES mvog_core)
 target_include_directories(test_mvog_core PRIVATE src/tools/bench)

@@ -17,5 +17,8 @@ struct ColumnSegment {
 /// segments of constant probability, bottom to top, adjacent segments of equal probability
 /// joined. Used to draw occupied space (Fig. 4, right) without sampling heights.
 std::vector<ColumnSegment> columnProfile(const CellVolumes& volumes);
+/// The same from a column as the map stores it (Map::column), into `segments` (cleared first,
+/// its capacity reused): for queries over many cells.
+void columnProfile(const ColumnView& column, std::vector<ColumnSegment>& segments);
 
 }  // namespace mvog

@@ -1,7 +1,10 @@
 // Google Benchmark micro-benchmarks of the MVOG core (no ROS): one reading, one ~25k-point depth
-// scan, 100k point queries, a 20 m x 20 m cross-section, a decay step, forgetting, save and load.
+// scan, 100k point queries, a 20 m x 20 m cross-section, a decay step, forgetting, save and load,
+// 10,000 segment checks (in the room, and all free in the floor below), frontiers and surfaces
+// over 40 m x 40 m.
 // The scene is a 10 m x 8 m x 3 m room holding two spheres, seen by a 176 x 144 depth camera
-// (the paper's SwissRanger) from 12 poses; the map is at 0.05 m. See BENCHMARKS.md.
+// (the paper's SwissRanger) from 12 poses; the map is at 0.05 m. The frontiers' scene is a floor
+// of 8 x 8 rooms of 5 m built cell by cell. See BENCHMARKS.md.
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -10,8 +13,11 @@
 #include <benchmark/benchmark.h>
 #include <Eigen/Geometry>
 
+#include "mvog/checks.h"
+#include "mvog/frontiers.h"
 #include "mvog/map.h"
 #include "mvog/map_io.h"
+#include "mvog/surfaces.h"
 #include "mvog_scene/scene.h"
 
 namespace {
@@ -202,6 +208,154 @@ void BM_Load(benchmark::State& state) {
   state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(data.size()));
 }
 BENCHMARK(BM_Load)->Unit(benchmark::kMillisecond);
+
+/// A 40 m x 40 m floor at 0.05 m (800 x 800 cells): 8 x 8 rooms of 5 m, each with a floor, free
+/// space up to 2.5 m and a ceiling, walls one cell thick with a door of 1 m in each, and a desk;
+/// a third of the rooms never observed, so that frontiers lie in the doors leading to them.
+mvog::Map floorMap() {
+  mvog::MapConfig config;
+  config.resolution = kResolution;
+  mvog::Map map(config);
+  auto volume = [](float bottom, float top, float density) {
+    return mvog::Volume{bottom, top, density * (top - bottom)};
+  };
+  const mvog::CellVolumes room{{volume(-1, 0, 4), volume(50, 52, 4)}, {volume(0, 50, 3)}};
+  const mvog::CellVolumes desk{{volume(-1, 0, 4), volume(14, 15, 4), volume(50, 52, 4)},
+                               {volume(0, 14, 3), volume(14, 15, 0.1f), volume(15, 50, 3)}};
+  const mvog::CellVolumes wall{{volume(-1, 52, 4)}, {}};
+  constexpr int kRoom = 100;  // cells
+  std::vector<mvog::Map::CellAssignment> cells;
+  for (int y = 0; y <= 8 * kRoom; ++y) {
+    for (int x = 0; x <= 8 * kRoom; ++x) {
+      const int along_x = x % kRoom;
+      const int along_y = y % kRoom;
+      const bool explored = (x / kRoom + y / kRoom) % 3 != 0;
+      const bool in_wall = along_x == 0 || along_y == 0;
+      const bool in_door = in_wall && (along_x == 0) != (along_y == 0) &&
+                           std::abs((along_x == 0 ? along_y : along_x) - kRoom / 2) < 10;
+      if (in_wall && !in_door) {
+        cells.push_back({{x, y}, wall});
+      } else if (explored || in_door) {
+        const bool at_desk = along_x >= 20 && along_x < 40 && along_y >= 20 && along_y < 30;
+        cells.push_back({{x, y}, at_desk ? desk : room});
+      }
+    }
+  }
+  map.setCellVolumes(cells);
+  return map;
+}
+
+const mvog::Map& sharedFloorMap() {
+  static const mvog::Map map = floorMap();
+  return map;
+}
+
+/// Checks `segments` with radius range(0) cm, by a SegmentChecker made for each call
+/// (range(1) = 0) or kept from call to call (1: the map does not change); reports the share found
+/// free.
+void checkSegments(benchmark::State& state, const mvog::Map& map,
+                   const std::vector<mvog::Segment>& segments) {
+  const double radius = static_cast<double>(state.range(0)) / 100.0;
+  mvog::SegmentChecker kept;
+  std::vector<mvog::SegmentCheck> checks;
+  for (auto _ : state) {
+    checks = state.range(1) != 0 ? kept.check(map, segments, radius)
+                                 : mvog::checkSegments(map, segments, radius);
+    benchmark::DoNotOptimize(checks.data());
+  }
+  double free = 0;
+  for (const mvog::SegmentCheck& check : checks) free += check.state == mvog::OccupancyState::kFree;
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(segments.size()));
+  state.counters["free"] = free / static_cast<double>(segments.size());
+}
+
+/// Radius 0 and 0.3 m by a checker made for the call, and 0.3 m by one kept from call to call.
+void segmentCheckArgs(benchmark::internal::Benchmark* benchmark) {
+  benchmark->Args({0, 0})->Args({30, 0})->Args({30, 1})->Unit(benchmark::kMillisecond);
+}
+
+/// 10,000 segments of 5 m from random points of the room in random directions: most leave the
+/// room, meet a sphere or the space the camera never saw.
+void BM_CheckSegments10k(benchmark::State& state) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> x(kRoomMin.x(), kRoomMax.x());
+  std::uniform_real_distribution<double> y(kRoomMin.y(), kRoomMax.y());
+  std::uniform_real_distribution<double> z(kRoomMin.z(), kRoomMax.z());
+  std::normal_distribution<double> direction;
+  std::vector<mvog::Segment> segments(10000);
+  for (mvog::Segment& segment : segments) {
+    segment.start = {x(random), y(random), z(random)};
+    const Eigen::Vector3d d(direction(random), direction(random), direction(random));
+    segment.end = segment.start + 5.0 * d.normalized();
+  }
+  checkSegments(state, sharedRoomMap(), segments);
+}
+BENCHMARK(BM_CheckSegments10k)->Apply(segmentCheckArgs);
+
+/// 10,000 segments of 5 m within the floor's observed rooms, clear of walls, desks, floor and
+/// ceiling by more than 0.3 m: all free, so every cell of every footprint is looked at.
+void BM_CheckFreeSegments10k(benchmark::State& state) {
+  std::mt19937 random(7);
+  std::uniform_int_distribution<int> room(0, 7);
+  std::uniform_real_distribution<double> within(0.4, 4.6);  // of a room's 5 m
+  std::uniform_real_distribution<double> height(1.1, 2.1);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI);
+  std::vector<mvog::Segment> segments;
+  while (segments.size() < 10000) {
+    const int rx = room(random);
+    const int ry = room(random);
+    if ((rx + ry) % 3 == 0) continue;  // never observed
+    const Eigen::Vector3d start(5.0 * rx + within(random), 5.0 * ry + within(random),
+                                height(random));
+    const double a = angle(random);
+    const double climb = height(random) - start.z();
+    const Eigen::Vector3d end =
+        start + Eigen::Vector3d(std::cos(a), std::sin(a), 0.0) * std::sqrt(25.0 - climb * climb) +
+        Eigen::Vector3d(0.0, 0.0, climb);
+    const Eigen::Vector2d inside = end.head<2>() - Eigen::Vector2d(5.0 * rx, 5.0 * ry);
+    if (inside.minCoeff() < 0.4 || inside.maxCoeff() > 4.6) continue;
+    segments.push_back({start, end});
+  }
+  checkSegments(state, sharedFloorMap(), segments);
+}
+BENCHMARK(BM_CheckFreeSegments10k)->Apply(segmentCheckArgs);
+
+std::size_t pointsOf(const mvog::Frontiers& frontiers) { return frontiers.points().size(); }
+std::size_t pointsOf(const mvog::Surfaces& surfaces) { return surfaces.surfaces().size(); }
+
+/// Frontiers (Kept = Frontiers) or surfaces (Surfaces) over the whole 40 m x 40 m floor, from
+/// scratch; reports the frontier voxels or the surfaces.
+template <class Kept>
+void BM_Pass40m(benchmark::State& state) {
+  const mvog::Map& map = sharedFloorMap();
+  std::size_t points = 0;
+  for (auto _ : state) {
+    Kept kept;
+    kept.update(map);
+    points = pointsOf(kept);
+  }
+  state.counters["points"] = static_cast<double>(points);
+}
+BENCHMARK_TEMPLATE(BM_Pass40m, mvog::Frontiers)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Pass40m, mvog::Surfaces)->Unit(benchmark::kMillisecond);
+
+/// An update of the floor's frontiers after one cell changed: its tile and four neighbours, then
+/// the clustering of every frontier voxel.
+void BM_FrontierUpdateOneTile40m(benchmark::State& state) {
+  mvog::Map map = floorMap();
+  mvog::Frontiers frontiers;
+  frontiers.update(map);
+  const mvog::CellVolumes original = map.cellVolumes({250, 250});
+  for (auto _ : state) {
+    state.PauseTiming();
+    map.setCellVolumes({250, 250}, map.cellVolumes({250, 250}).positive.size() == 2
+                                       ? mvog::CellVolumes{}
+                                       : original);
+    state.ResumeTiming();
+    frontiers.update(map);
+  }
+}
+BENCHMARK(BM_FrontierUpdateOneTile40m)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -18,6 +18,8 @@
 #include <gtest/gtest.h>
 #include <json/json.h>
 
+#include "../recordings.h"
+
 namespace {
 
 class BenchSmokeTest : public ::testing::Test {
@@ -84,23 +86,9 @@ class BenchSmokeTest : public ::testing::Test {
   std::string directory_;
 };
 
-std::string dataDirectory() {
-  const char* from_environment = std::getenv("MVOG_DATA_DIR");
-  if (from_environment != nullptr && from_environment[0] != '\0') return from_environment;
-  return std::string(MVOG_SOURCE_DIR) + "/../shared/data";
-}
-
-bool inCi() {
-  const char* ci = std::getenv("CI");
-  return ci != nullptr && std::strcmp(ci, "true") == 0;
-}
-
 TEST_F(BenchSmokeTest, BothBackendsMapTheSphericalScan) {
-  const std::string input = dataDirectory() + "/spherical_scan.graph";
-  if (!std::ifstream(input)) {
-    if (inCi()) FAIL() << input << " is missing (set MVOG_DATA_DIR to the shared data)";
-    GTEST_SKIP() << input << " is missing: set MVOG_DATA_DIR to the shared data directory";
-  }
+  const std::string input = mvog_test::dataDirectory() + "/spherical_scan.graph";
+  MVOG_REQUIRE_RECORDING(input);
   const std::string json = directory_ + "/x.json";
   std::string errors;
   ASSERT_EQ(

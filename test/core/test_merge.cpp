@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "../recordings.h"
 #include "input.h"  // mvog_bench's scan graph reader (src/tools/bench), ROS-free
 #include "mvog/map.h"
 #include "mvog/map_io.h"
@@ -304,13 +305,6 @@ TEST(Merge, TwoHalvesOfSyntheticScansAgreeWithTheMapOfAll) {
   }
 }
 
-std::string dataDirectory() {
-  const char* directory = std::getenv("MVOG_DATA_DIR");
-  return directory != nullptr && *directory != '\0'
-             ? directory
-             : std::string(MVOG_SOURCE_DIR) + "/../shared/data";
-}
-
 /// A recording of the shared data (OctoMap scan graphs: /work/shared/data/README.md), at a
 /// resolution, with a range limit.
 struct Recording {
@@ -323,12 +317,8 @@ class MergeRecording : public ::testing::TestWithParam<Recording> {};
 
 TEST_P(MergeRecording, TwoHalvesAgreeWithTheMapOfAll) {
   const Recording& recording = GetParam();
-  const std::string path = dataDirectory() + "/" + recording.file;
-  if (!std::ifstream(path)) {
-    const char* ci = std::getenv("CI");
-    if (ci != nullptr && std::string(ci) == "true") FAIL() << path << " not found (CI=true)";
-    GTEST_SKIP() << path << " not found: set MVOG_DATA_DIR to the directory of the recordings";
-  }
+  const std::string path = mvog_test::dataDirectory() + "/" + recording.file;
+  MVOG_REQUIRE_RECORDING(path);
   const mvog_bench::InputData input = mvog_bench::loadScanGraph(path);
   MapConfig config;
   config.resolution = recording.resolution;
