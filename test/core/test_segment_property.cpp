@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "input.h"  // mvog_bench's scan graph reader (src/tools/bench), ROS-free
 #include "../recordings.h"
+#include "input.h"  // mvog_bench's scan graph reader (src/tools/bench), ROS-free
 #include "mvog/checks.h"
 #include "mvog/column.h"
 #include "planning_scene.h"
