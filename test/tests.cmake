@@ -41,6 +41,7 @@ mvog_add_gtest(test_mvog_core
   SOURCES test/core/test_volume.cpp test/core/test_raster.cpp test/core/test_insertion.cpp
           test/core/test_queries.cpp test/core/test_map.cpp test/core/test_map_io.cpp
           test/core/test_column.cpp test/core/test_height_colour.cpp
+          test/core/test_depth_image.cpp
   LIBRARIES mvog_core)
 # A process saving maps, killed at random moments: the file always loads (RELIABILITY.md).
 mvog_add_gtest(test_save_sigkill
