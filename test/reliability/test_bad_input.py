@@ -429,6 +429,7 @@ class BadInput(unittest.TestCase):
                  ("occupancy_threshold", {"occupancy_threshold": NAN}),
                  ("projection_min_z", {"projection_min_z": 2.0, "projection_max_z": 1.0}),
                  ("max_query_points", {"max_query_points": 0}),
+                 ("depth_stride", {"depth_stride": 0}),
                  ("autosave_period", {"autosave_period": -5.0})]
         for k, (parameter, values) in enumerate(cases):
             server = rel.Server("mapper_refused_%d" % k, values)
