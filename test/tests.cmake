@@ -118,7 +118,7 @@ if(TARGET mvog_bench)
   find_package(jsoncpp REQUIRED)
   mvog_add_gtest(test_mvog_bench
     SOURCES test/bench/test_bench_smoke.cpp
-    LIBRARIES JsonCpp::JsonCpp)
+    LIBRARIES JsonCpp::JsonCpp ${catkin_LIBRARIES})
   target_compile_definitions(test_mvog_bench PRIVATE
     MVOG_BENCH_EXECUTABLE="$<TARGET_FILE:mvog_bench>"
     MVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
