@@ -51,8 +51,7 @@ mvog_add_gtest(test_save_sigkill
 # ---- mvog_ros_conversions: the message conversions and the map's lock ------------------------
 if(TARGET mvog_ros_conversions)
   mvog_add_gtest(test_mvog_ros_conversions
-    SOURCES test/ros/test_conversions.cpp test/ros/test_depth_image_to_scan.cpp
-            test/ros/test_writer_preferring_mutex.cpp
+    SOURCES test/ros/test_conversions.cpp test/ros/test_writer_preferring_mutex.cpp
     LIBRARIES mvog_ros_conversions mvog_scene)
   # The core's promises about threads, and the server's lock pattern (also under TSan).
   mvog_add_gtest(test_concurrency

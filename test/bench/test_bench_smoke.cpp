@@ -147,27 +147,21 @@ TEST_F(BenchSmokeTest, ReadsEveryNodeOfAGraphItWrote) {
   EXPECT_EQ(root["input"]["scans"].asUInt64(), 2u);
 }
 
-/// A depth image of `width` x `height` pixels of `encoding` (16UC1 or 32FC1), every pixel
-/// `depth` (its unit), at `seconds`.
+/// A depth image of `width` x `height` pixels of `encoding` (Pixel: std::uint16_t for 16UC1,
+/// float for 32FC1), every pixel `depth`, at `seconds`.
+template <class Pixel>
 sensor_msgs::Image depthImage(const std::string& encoding, std::uint32_t width,
-                              std::uint32_t height, float depth, double seconds) {
+                              std::uint32_t height, Pixel depth, double seconds) {
   sensor_msgs::Image image;
   image.header.frame_id = "camera";
   image.header.stamp = ros::Time(seconds);
   image.width = width;
   image.height = height;
   image.encoding = encoding;
-  const std::uint32_t pixel_bytes = encoding == "16UC1" ? 2 : 4;
-  image.step = width * pixel_bytes;
-  image.data.resize(std::size_t{image.step} * height);
-  for (std::size_t k = 0; k < std::size_t{width} * height; ++k) {
-    if (pixel_bytes == 2) {
-      const auto millimetres = static_cast<std::uint16_t>(depth);
-      std::memcpy(image.data.data() + 2 * k, &millimetres, 2);
-    } else {
-      std::memcpy(image.data.data() + 4 * k, &depth, 4);
-    }
-  }
+  image.step = width * static_cast<std::uint32_t>(sizeof(Pixel));
+  const std::vector<Pixel> pixels(std::size_t{width} * height, depth);
+  image.data.resize(pixels.size() * sizeof(Pixel));
+  std::memcpy(image.data.data(), pixels.data(), image.data.size());
   return image;
 }
 
@@ -194,14 +188,14 @@ TEST_F(BenchSmokeTest, ReadsTheDepthImagesOfABagWithTheCameraInfoOfTheirStamp) {
     bag.write("/tf_static", ros::Time(1.0), tf);
     const std::string image_topic = "/camera/depth/image";
     const std::string info_topic = "/camera/depth/camera_info";
-    const sensor_msgs::Image millimetres = depthImage("16UC1", 4, 3, 2000.0f, 2.0);
+    const sensor_msgs::Image millimetres = depthImage<std::uint16_t>("16UC1", 4, 3, 2000, 2.0);
     bag.write(info_topic, ros::Time(2.0), cameraInfoOf(millimetres));
     bag.write(image_topic, ros::Time(2.0), millimetres);
     // Not range data: not read.
-    bag.write("/camera/rgb/image", ros::Time(2.5), depthImage("rgb8", 4, 3, 1.0f, 2.5));
+    bag.write("/camera/rgb/image", ros::Time(2.5), depthImage<float>("rgb8", 4, 3, 1.0f, 2.5));
     // Without the camera info of its stamp: skipped.
-    bag.write(image_topic, ros::Time(3.0), depthImage("16UC1", 4, 3, 1000.0f, 3.0));
-    sensor_msgs::Image metres = depthImage("32FC1", 4, 3, 1.5f, 4.0);
+    bag.write(image_topic, ros::Time(3.0), depthImage<std::uint16_t>("16UC1", 4, 3, 1000, 3.0));
+    sensor_msgs::Image metres = depthImage<float>("32FC1", 4, 3, 1.5f, 4.0);
     const float nan = std::numeric_limits<float>::quiet_NaN();
     std::memcpy(metres.data.data() + 4 * 5, &nan, 4);  // one pixel says nothing
     bag.write(image_topic, ros::Time(4.0), metres);    // its camera info comes after it

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "mvog/map.h"
+#include "mvog_ros/conversions.h"
 #include "mvog_ros/mapper_config.h"
 
 namespace mvog_ros {
@@ -81,8 +82,19 @@ class SensorInput {
           });
         });
   }
-  /// Drops a message that cannot be converted, counted, with a throttled warning.
-  void rejectMessage(const std::string& message_type, const std::string& why);
+  /// Enqueues the scan `convert(skipped)` returns, the readings it skipped counted as rejected;
+  /// a message it throws InvalidMessage for is dropped, counted, with a throttled warning.
+  template <class Convert>
+  void enqueueConverted(const std::string& message_type, Convert&& convert) {
+    try {
+      std::size_t skipped = 0;
+      mvog::Scan scan = convert(skipped);
+      context_.counters.readings_rejected += skipped;
+      context_.enqueue(std::move(scan), message_type);
+    } catch (const InvalidMessage& e) {
+      rejectMessage(message_type, e.what());
+    }
+  }
 
   using ConvertAndEnqueue = std::function<void(const Eigen::Isometry3d& map_from_sensor)>;
   /// Converts the message if its transform is there, else keeps it waiting.
@@ -101,6 +113,8 @@ class SensorInput {
   /// Retries the waiting messages (timer): transforms arrive on tf's own thread.
   void retryWaitingMessages(const ros::TimerEvent&);
   void dropForTransform(const std_msgs::Header& header, const std::string& why);
+  /// Drops a message that cannot be converted, counted, with a throttled warning.
+  void rejectMessage(const std::string& message_type, const std::string& why);
 
   std::mutex mutex_;
   std::deque<WaitingMessage> waiting_;  // oldest first

@@ -89,16 +89,11 @@ void DepthImageInput::receivePair(const sensor_msgs::ImageConstPtr& image,
 void DepthImageInput::convertAndEnqueue(const sensor_msgs::Image& image,
                                         const sensor_msgs::CameraInfo& camera_info,
                                         const Eigen::Isometry3d& map_from_camera) {
-  try {
-    std::size_t skipped = 0;
-    mvog::Scan converted =
-        depthImageToScan(image, camera_info, map_from_camera, config_,
-                         static_cast<std::size_t>(context_.config.max_points_per_message), skipped);
-    context_.counters.readings_rejected += skipped;
-    context_.enqueue(std::move(converted), "depth image");
-  } catch (const InvalidMessage& e) {
-    rejectMessage("depth image", e.what());
-  }
+  enqueueConverted("depth image", [&](std::size_t& skipped) {
+    return depthImageToScan(image, camera_info, map_from_camera, config_,
+                            static_cast<std::size_t>(context_.config.max_points_per_message),
+                            skipped);
+  });
 }
 
 }  // namespace mvog_ros
