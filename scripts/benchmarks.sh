@@ -5,6 +5,7 @@
 # the outputs (JSON and text) to OUT and prints the report's tables (scripts/benchmark_tables.py).
 #   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~15 min here)
 # MVOG_BENCH_REPEAT (default 3): insertions per backend, the fastest reported.
+# shellcheck source=scripts/common.sh
 source "$(dirname "$0")/common.sh"
 
 OUT=${1:-$WORKSPACE/benchmarks}

@@ -9,6 +9,7 @@
 #   scripts/demo.sh [--bag FILE] [--scan-topic T] [--cloud-topic T] [--depth-topic T]
 #                   [--resolution R] [--config YAML] [--heights "Z1 Z2"] [--rate X] [--output DIR]
 # (--depth-topic: a depth image topic, its camera info on the sibling camera_info topic.)
+# shellcheck source=scripts/common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 bag=""
@@ -100,7 +101,7 @@ rosbag play --clock --keep-alive --wait-for-subscribers -q -r "$rate" "$bag" \
   --topics "$scan_topic" "$cloud_topic" "$depth_topic" "$depth_info_topic" /tf /tf_static \
   >"$LOG_DIR/demo-rosbag.log" 2>&1 &
 player=$!
-BACKGROUND_PIDS+=($player)
+BACKGROUND_PIDS+=("$player")
 # Until the statistics account for every sensor message of the bag (inserted or dropped for a
 # reason they count); messages lost uncounted would keep them short, so also until they have
 # stood still for 10 s once the bag has played.

@@ -5,6 +5,7 @@
 #
 #   scripts/load.sh [--points N | --depth WxH [--depth-encoding 16UC1|32FC1] [--depth-stride K]]
 #                   [--rate HZ] [--duration S] [--query-points N] [--json FILE]
+# shellcheck source=scripts/common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 install_missing_packages
