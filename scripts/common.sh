@@ -12,8 +12,8 @@ LOG_DIR=$WORKSPACE/logs
 export MVOG_DATA_DIR=${MVOG_DATA_DIR:-$(cd "$REPO/.." && pwd)/shared/data}
 
 # Debian 12 packages: ROS 1 (Debian's own build), PCL, OctoMap, test and headless-rviz tools,
-# clang with its sanitizer and libFuzzer runtimes (scripts/sanitizers.sh), the linters
-# (scripts/lint.sh).
+# valgrind (scripts/benchmarks.sh's instruction counts), clang with its sanitizer and libFuzzer
+# runtimes (scripts/sanitizers.sh), the linters (scripts/lint.sh).
 MVOG_PACKAGES=(
   build-essential cmake libeigen3-dev libgtest-dev libbenchmark-dev
   ros-core-python-dev ros-base-dev python3-rostest rosbash python3-rosbag python3-numpy
@@ -22,7 +22,7 @@ MVOG_PACKAGES=(
   libvisualization-msgs-dev libnav-msgs-dev libmap-msgs-dev libdiagnostic-updater-dev
   libimage-transport-dev
   rviz tf2-tools liboctomap-dev octomap-tools
-  xvfb xauth x11-utils libgl1-mesa-dri imagemagick
+  xvfb xauth x11-utils libgl1-mesa-dri imagemagick valgrind
   clang-14 libclang-rt-14-dev clang-format-14 clang-tidy-14 catkin-lint shellcheck
 )
 
