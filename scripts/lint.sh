@@ -5,6 +5,8 @@
 #                 --strict: a warning fails like an error. Each suppression is a
 #                 `#catkin_lint: ignore` pragma beside the code, with its reason.
 #   ShellCheck    every shell script (scripts/, .ci/, test/), following what they source.
+#   changelog     CHANGELOG.rst parses as catkin's release tools read it and its newest entry is
+#                 package.xml's version (a version bump without its entry fails).
 #   clang-tidy    clang-tidy-14 on every source of src/ with the checks of .clang-tidy, through the
 #                 compile commands of the catkin workspace (scripts/test.sh builds it first; run
 #                 alone, this builds it too).
@@ -43,6 +45,24 @@ shellcheck_scripts() (
     sort -z | xargs -0 shellcheck -x
 )
 lint shellcheck shellcheck_scripts
+
+changelog_matches_version() {
+  python3 - "$REPO" <<'PY'
+import os
+import sys
+from catkin_pkg.changelog import get_changelog_from_path
+from catkin_pkg.package import parse_package
+
+repo = sys.argv[1]
+version = parse_package(repo).version
+entries = [str(v) for v, _, _ in get_changelog_from_path(
+    os.path.join(repo, "CHANGELOG.rst")).foreach_version()]
+if not entries or entries[0] != version:
+    sys.exit(f"CHANGELOG.rst's newest entry is {entries[0] if entries else 'missing'}, "
+             f"package.xml says {version}: add its entry")
+PY
+}
+lint changelog changelog_matches_version
 
 # The sources are compiled through the workspace's link to the repository: the header filter
 # keeps the findings to our own headers (not the generated message headers in devel/); the
