@@ -142,6 +142,20 @@ def main(out):
         print(table(["file", "disregarded"] + [f"{n} m" if n != "inf" else "unbounded"
                                               for n in lengths], out_of_range_rows))
 
+    table_one_rows = []
+    for path in sorted(glob.glob(f"{out}/table_one_*.json")):
+        name = file_name(path, "table_one_")
+        for t in sorted(load(path)["table_one"], key=lambda t: -t["resolution"]):
+            table_one_rows.append([
+                name, f"{t['resolution']:g}", megabytes(t["point_cloud_bytes"]),
+                megabytes(t["voxel_grid_bytes"]), megabytes(t["octomap_bytes"]),
+                megabytes(t["mvog_bytes"]), f"{t['mvog_bytes'] / t['octomap_bytes']:.2f}"])
+    if table_one_rows:
+        print("\n### Table I's accounting (MB: 12 bytes a point; 4 a voxel of the smallest grid "
+              "holding every ray; OctoMap's pruned tree; 12 bytes a volume + 8 a cell)\n")
+        print(table(["data", "res (m)", "point cloud", "voxel grid", "OctoMap", "MVOG",
+                     "MVOG / OctoMap"], table_one_rows))
+
     instructions = []
     for path in sorted(glob.glob(f"{out}/instructions_mvog_*")):
         name = os.path.basename(path)[len("instructions_mvog_"):]
