@@ -29,7 +29,7 @@ namespace mvog_ros {
 class Mapper {
  public:
   /// Throws mvog::ConfigError naming the parameter at fault (~map_file if it cannot be loaded).
-  Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  Mapper(const ros::NodeHandle& nh, ros::NodeHandle private_nh);
   /// Stops the inputs, inserts what is queued, and autosaves once more (with autosave on).
   ~Mapper();
   Mapper(const Mapper&) = delete;

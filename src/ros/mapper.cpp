@@ -6,7 +6,7 @@
 
 namespace mvog_ros {
 
-Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
+Mapper::Mapper(const ros::NodeHandle& nh, ros::NodeHandle private_nh)
     : config_(MapperConfig::fromParameters(private_nh)),
       map_(initialMap(config_.map_files, config_.map)),
       tf_listener_(tf_buffer_, nh),
