@@ -196,6 +196,9 @@ mvog::CellRange IncrementalGrid::update(const mvog::Map& map,
   mvog::CellRange touched = kNoCells;
   for (const mvog::TileIndex& tile : changed) {
     const mvog::CellRange cells = mvog::Map::tileCells(tile);
+    // The grid covers whole tiles: one that begins outside it (a tile the map removed, beyond a
+    // layout that moved with the map's bounds) lies wholly outside.
+    if (!cells_.contains(cells.min)) continue;
     write(cells, compute_(map, cells));
     touched =
         touched.empty()
