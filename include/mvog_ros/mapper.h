@@ -13,6 +13,7 @@
 #include "mvog_ros/publications/marker_publication.h"
 #include "mvog_ros/publications/statistics_publication.h"
 #include "mvog_ros/services/map_file_services.h"
+#include "mvog_ros/services/planning_services.h"
 #include "mvog_ros/services/query_services.h"
 #include "mvog_ros/services/reset_service.h"
 #include "mvog_ros/shared_map.h"
@@ -24,7 +25,8 @@ namespace mvog_ros {
 ///   sensor inputs      subscribe, wait for tf, convert (SensorInputs: inputs/)
 ///   insertion worker   bounded queue and thread, the only writer of readings (InsertionWorker)
 ///   publications       markers, grids, binary map, statistics (publications/)
-///   services           queries, map files and autosave, reset (services/)
+///   services           queries, segment and box checks, map files and autosave, reset
+///                      (services/)
 /// and decays the map itself. Callbacks may run on several threads at once.
 class Mapper {
  public:
@@ -53,6 +55,7 @@ class Mapper {
   GridPublication grids_;
   BinaryMapPublication binary_map_;
   QueryServices queries_;
+  PlanningServices checks_;
   MapFileServices map_files_;
   ros::Timer decay_timer_;
   SensorInputs inputs_;

@@ -17,6 +17,7 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
       binary_map_(private_nh, config_.publications, config_.frame_id, map_),
       queries_(private_nh, config_.queries, config_.frame_id, config_.occupancy_threshold,
                config_.max_cross_section_cells, config_.map.max_coordinate, map_, tf_buffer_),
+      checks_(private_nh, config_.queries, config_.planning, config_.frame_id, map_, tf_buffer_),
       map_files_(private_nh, config_.map_files, map_,
                  [this](mvog::Map&& map) { replaceMap(std::move(map)); }),
       inputs_(nh, config_.inputs, config_.frame_id, config_.insertion.max_range, tf_buffer_,

@@ -9,7 +9,7 @@
 
 namespace mvog_ros {
 
-// What the query services (QueryServices) check of every request.
+// What the query services (QueryServices, PlanningServices) check of every request.
 
 /// Whether a request of `count` points (segments, boxes: `what`) is within ~max_query_points;
 /// if not, `refusal` says so.
