@@ -97,7 +97,7 @@ endif()
 mvog_add_gtest(test_mvog_ros
   SOURCES test/ros/test_map_paths.cpp test/ros/test_mapper_config.cpp
           test/ros/test_visualization.cpp test/ros/test_incremental_grid.cpp
-          test/ros/test_insertion_worker.cpp
+          test/ros/test_insertion_worker.cpp test/ros/test_planning_messages.cpp
   LIBRARIES mvog_ros)
 # The server through its ROS interface, as node and as nodelet (test/ros/*.test).
 find_package(rostest REQUIRED)

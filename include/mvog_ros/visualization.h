@@ -10,6 +10,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "mvog/map.h"
+#include "mvog/surfaces.h"
 
 namespace mvog_ros {
 
@@ -35,6 +36,7 @@ visualization_msgs::Marker deleteAllMarker(const std::string& frame_id, const ro
 /// The occupancy grid value of a probability (0..100) or of unknown (-1).
 std::int8_t gridValue(float probability);
 std::int8_t gridValue(mvog::OccupancyState state);
+std::int8_t gridValue(mvog::Traversability traversability);
 
 /// A nav_msgs/OccupancyGrid of a core grid, at height `z` (the grid's origin height).
 template <class T>

@@ -138,6 +138,10 @@ std::int8_t gridValue(mvog::OccupancyState state) {
   return -1;
 }
 
+std::int8_t gridValue(mvog::Traversability traversability) {
+  return static_cast<std::int8_t>(traversability);  // its values are those of OccupancyGrid
+}
+
 template <class T>
 nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::Grid2D<T>& grid, double z,
                                         const std::string& frame_id, const ros::Time& stamp) {
@@ -160,6 +164,8 @@ nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::Grid2D<T>& grid, double z,
 template nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::CrossSection&, double,
                                                  const std::string&, const ros::Time&);
 template nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::Projection&, double,
+                                                 const std::string&, const ros::Time&);
+template nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::TraversableMap&, double,
                                                  const std::string&, const ros::Time&);
 
 mvog::CellRange IncrementalGrid::update(const mvog::Map& map,

@@ -18,11 +18,12 @@ namespace mvog_ros {
 std::optional<std::vector<mvog::TileIndex>> tilesChangedSince(const mvog::Map& map,
                                                               std::uint64_t revision);
 
-/// What MarkerPublication and GridPublication share: every ~publish_period they publish what
-/// changed in the map since they last did (the tiles modified or removed since:
-/// tilesChangedSince; all of them afresh if the map cannot tell), and once the map was replaced
-/// (~load_map, ~reset) they first clear what they showed of the previous one. Their connection
-/// callbacks take the same lock (mutex_, then the map's) to send a new subscriber everything.
+/// What MarkerPublication, GridPublication and PlanningPublication share: every ~publish_period
+/// they publish what changed in the map since they last did (the tiles modified or removed
+/// since: tilesChangedSince; all of them afresh if the map cannot tell), and once the map was
+/// replaced (~load_map, ~reset) they first clear what they showed of the previous one. Their
+/// connection callbacks take the same lock (mutex_, then the map's) to send a new subscriber
+/// everything.
 class ChangePublication {
  public:
   virtual ~ChangePublication();
