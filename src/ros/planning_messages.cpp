@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-
-#include <sensor_msgs/point_cloud2_iterator.h>
+#include <cstring>
+#include <utility>
 
 #include "mvog/height_colour.h"
 #include "mvog_ros/visualization.h"
@@ -11,35 +11,55 @@
 namespace mvog_ros {
 namespace {
 
-/// A cloud without fields yet; dense: none of its points will be NaN.
-sensor_msgs::PointCloud2 emptyCloud(const std::string& frame_id, const ros::Time& stamp) {
+/// An unorganized, dense cloud of `size` points whose fields, in this order, are 4 bytes each:
+/// (name, sensor_msgs::PointField datatype).
+sensor_msgs::PointCloud2 cloudOf(std::size_t size,
+                                 const std::vector<std::pair<const char*, std::uint8_t>>& fields,
+                                 const std::string& frame_id, const ros::Time& stamp) {
   sensor_msgs::PointCloud2 cloud;
   cloud.header.frame_id = frame_id;
   cloud.header.stamp = stamp;
+  for (const auto& [name, datatype] : fields) {
+    sensor_msgs::PointField field;
+    field.name = name;
+    field.offset = static_cast<std::uint32_t>(4 * cloud.fields.size());
+    field.datatype = datatype;
+    field.count = 1;
+    cloud.fields.push_back(field);
+  }
+  cloud.height = 1;
+  cloud.width = static_cast<std::uint32_t>(size);
+  cloud.point_step = static_cast<std::uint32_t>(4 * fields.size());
+  cloud.row_step = cloud.point_step * cloud.width;
+  cloud.is_bigendian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;  // put() writes the host's order
   cloud.is_dense = true;
+  cloud.data.resize(std::size_t{cloud.row_step});
   return cloud;
+}
+
+/// Writes field `field` (4 bytes) of point `point`.
+template <class Value>
+void put(sensor_msgs::PointCloud2& cloud, std::size_t point, std::size_t field, Value value) {
+  static_assert(sizeof(Value) == 4, "the clouds' fields are 4 bytes");
+  std::memcpy(&cloud.data[point * cloud.point_step + 4 * field], &value, sizeof(Value));
 }
 
 }  // namespace
 
 sensor_msgs::PointCloud2 frontierCloud(const std::vector<mvog::FrontierPoint>& points,
                                        const std::string& frame_id, const ros::Time& stamp) {
-  sensor_msgs::PointCloud2 cloud = emptyCloud(frame_id, stamp);
-  sensor_msgs::PointCloud2Modifier modifier(cloud);
-  modifier.setPointCloud2Fields(
-      4, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1, sensor_msgs::PointField::FLOAT32, "z", 1,
-      sensor_msgs::PointField::FLOAT32, "cluster", 1, sensor_msgs::PointField::UINT32);
-  modifier.resize(points.size());
-  sensor_msgs::PointCloud2Iterator<float> x(cloud, "x");
-  sensor_msgs::PointCloud2Iterator<float> y(cloud, "y");
-  sensor_msgs::PointCloud2Iterator<float> z(cloud, "z");
-  sensor_msgs::PointCloud2Iterator<std::uint32_t> cluster(cloud, "cluster");
-  for (const mvog::FrontierPoint& point : points) {
-    *x = point.x;
-    *y = point.y;
-    *z = point.z;
-    *cluster = point.cluster;
-    ++x, ++y, ++z, ++cluster;
+  using sensor_msgs::PointField;
+  sensor_msgs::PointCloud2 cloud = cloudOf(points.size(),
+                                           {{"x", PointField::FLOAT32},
+                                            {"y", PointField::FLOAT32},
+                                            {"z", PointField::FLOAT32},
+                                            {"cluster", PointField::UINT32}},
+                                           frame_id, stamp);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    put(cloud, k, 0, points[k].x);
+    put(cloud, k, 1, points[k].y);
+    put(cloud, k, 2, points[k].z);
+    put(cloud, k, 3, points[k].cluster);
   }
   return cloud;
 }
@@ -49,14 +69,9 @@ visualization_msgs::MarkerArray frontierMarkers(const std::vector<mvog::Frontier
                                                 const std::string& frame_id,
                                                 const ros::Time& stamp) {
   visualization_msgs::MarkerArray markers;
-  visualization_msgs::Marker clear;
-  clear.header.frame_id = frame_id;
-  clear.header.stamp = stamp;
-  clear.action = visualization_msgs::Marker::DELETEALL;
-  clear.pose.orientation.w = 1.0;
-  markers.markers.push_back(clear);
+  markers.markers.push_back(deleteAllMarker(frame_id, stamp));
   for (std::uint32_t k = 0; k < num_clusters; ++k) {
-    visualization_msgs::Marker cluster = clear;
+    visualization_msgs::Marker cluster = markers.markers.front();
     cluster.action = visualization_msgs::Marker::ADD;
     cluster.ns = "frontiers";
     cluster.id = static_cast<int>(k);
@@ -82,25 +97,20 @@ visualization_msgs::MarkerArray frontierMarkers(const std::vector<mvog::Frontier
 
 sensor_msgs::PointCloud2 surfaceCloud(const std::vector<mvog::Surface>& surfaces,
                                       const std::string& frame_id, const ros::Time& stamp) {
-  sensor_msgs::PointCloud2 cloud = emptyCloud(frame_id, stamp);
-  sensor_msgs::PointCloud2Modifier modifier(cloud);
-  modifier.setPointCloud2Fields(
-      5, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1, sensor_msgs::PointField::FLOAT32, "z", 1,
-      sensor_msgs::PointField::FLOAT32, "clearance", 1, sensor_msgs::PointField::FLOAT32,
-      "probability", 1, sensor_msgs::PointField::FLOAT32);
-  modifier.resize(surfaces.size());
-  sensor_msgs::PointCloud2Iterator<float> x(cloud, "x");
-  sensor_msgs::PointCloud2Iterator<float> y(cloud, "y");
-  sensor_msgs::PointCloud2Iterator<float> z(cloud, "z");
-  sensor_msgs::PointCloud2Iterator<float> clearance(cloud, "clearance");
-  sensor_msgs::PointCloud2Iterator<float> probability(cloud, "probability");
-  for (const mvog::Surface& surface : surfaces) {
-    *x = surface.x;
-    *y = surface.y;
-    *z = surface.z;
-    *clearance = surface.clearance;
-    *probability = surface.probability;
-    ++x, ++y, ++z, ++clearance, ++probability;
+  using sensor_msgs::PointField;
+  sensor_msgs::PointCloud2 cloud = cloudOf(surfaces.size(),
+                                           {{"x", PointField::FLOAT32},
+                                            {"y", PointField::FLOAT32},
+                                            {"z", PointField::FLOAT32},
+                                            {"clearance", PointField::FLOAT32},
+                                            {"probability", PointField::FLOAT32}},
+                                           frame_id, stamp);
+  for (std::size_t k = 0; k < surfaces.size(); ++k) {
+    put(cloud, k, 0, surfaces[k].x);
+    put(cloud, k, 1, surfaces[k].y);
+    put(cloud, k, 2, surfaces[k].z);
+    put(cloud, k, 3, surfaces[k].clearance);
+    put(cloud, k, 4, surfaces[k].probability);
   }
   return cloud;
 }
