@@ -34,11 +34,12 @@ class PlanningServices {
   bool checkSegments(mvog::CheckSegments::Request& request,
                      mvog::CheckSegments::Response& response);
   bool checkBoxes(mvog::CheckBoxes::Request& request, mvog::CheckBoxes::Response& response);
-  /// The transform of a request of `count` queries (`what`) whose two lists of points have
-  /// `count` and `other_count` entries; nothing, with `refusal` saying why, if it is refused.
+  /// The transform of a request of `count` queries (`what`) whose two lists of points (`lists`)
+  /// have `count` and `other_count` entries; nothing, with `refusal` saying why, if it is
+  /// refused.
   std::optional<Eigen::Isometry3d> acceptRequest(const std::string& frame_id, std::size_t count,
                                                  std::size_t other_count, const char* what,
-                                                 std::string& refusal) const;
+                                                 const char* lists, std::string& refusal) const;
 
   const QueryServicesConfig config_;
   const mvog::PlanningConfig planning_;

@@ -34,14 +34,12 @@ PlanningServices::PlanningServices(ros::NodeHandle& private_nh, const QueryServi
       check_boxes_(
           private_nh.advertiseService("check_boxes", &PlanningServices::checkBoxes, this)) {}
 
-std::optional<Eigen::Isometry3d> PlanningServices::acceptRequest(const std::string& frame_id,
-                                                                 std::size_t count,
-                                                                 std::size_t other_count,
-                                                                 const char* what,
-                                                                 std::string& refusal) const {
+std::optional<Eigen::Isometry3d> PlanningServices::acceptRequest(
+    const std::string& frame_id, std::size_t count, std::size_t other_count, const char* what,
+    const char* lists, std::string& refusal) const {
   if (!withinMaxQueryPoints(count, what, config_.max_query_points, refusal)) return std::nullopt;
   if (count != other_count) {
-    refusal = "refused: the two lists of points differ in length (" + std::to_string(count) +
+    refusal = std::string("refused: ") + lists + " differ in length (" + std::to_string(count) +
               " and " + std::to_string(other_count) + ")";
     return std::nullopt;
   }
@@ -50,8 +48,9 @@ std::optional<Eigen::Isometry3d> PlanningServices::acceptRequest(const std::stri
 
 bool PlanningServices::checkSegments(mvog::CheckSegments::Request& request,
                                      mvog::CheckSegments::Response& response) {
-  const std::optional<Eigen::Isometry3d> map_from_frame = acceptRequest(
-      request.frame_id, request.starts.size(), request.ends.size(), "segments", response.message);
+  const std::optional<Eigen::Isometry3d> map_from_frame =
+      acceptRequest(request.frame_id, request.starts.size(), request.ends.size(), "segments",
+                    "starts and ends", response.message);
   if (!map_from_frame) return true;
   std::vector<mvog::Segment> segments;
   segments.reserve(request.starts.size());
@@ -86,7 +85,7 @@ bool PlanningServices::checkBoxes(mvog::CheckBoxes::Request& request,
                                   mvog::CheckBoxes::Response& response) {
   const std::optional<Eigen::Isometry3d> map_from_frame =
       acceptRequest(request.frame_id, request.min_corners.size(), request.max_corners.size(),
-                    "boxes", response.message);
+                    "boxes", "min_corners and max_corners", response.message);
   if (!map_from_frame) return true;
   std::vector<mvog::Box> boxes;
   boxes.reserve(request.min_corners.size());
