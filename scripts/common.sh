@@ -18,6 +18,7 @@ MVOG_PACKAGES=(
   python3-rospy python3-sensor-msgs python3-geometry-msgs python3-tf2-msgs python3-tf2-ros
   libpcl-dev libtf2-ros-dev libtf2-eigen-dev libtf2-msgs-dev libstd-srvs-dev
   libvisualization-msgs-dev libnav-msgs-dev libmap-msgs-dev libdiagnostic-updater-dev
+  libimage-transport-dev
   rviz tf2-tools liboctomap-dev octomap-tools
   xvfb xauth x11-utils libgl1-mesa-dri imagemagick
   clang-14 libclang-rt-14-dev clang-format-14

@@ -46,6 +46,7 @@ mvog_add_gtest(test_mvog_core
           test/core/test_lifecycle.cpp test/core/test_merge.cpp test/core/test_map_update.cpp
           test/core/test_checks.cpp test/core/test_segment_property.cpp
           test/core/test_frontiers.cpp test/core/test_surfaces.cpp
+          test/core/test_depth_image.cpp
           src/tools/bench/scan_graph_input.cpp
   LIBRARIES mvog_core)
 target_include_directories(test_mvog_core PRIVATE src/tools/bench)
@@ -59,7 +60,7 @@ mvog_add_gtest(test_save_sigkill
 if(TARGET mvog_ros_conversions)
   mvog_add_gtest(test_mvog_ros_conversions
     SOURCES test/ros/test_conversions.cpp test/ros/test_writer_preferring_mutex.cpp
-    LIBRARIES mvog_ros_conversions)
+    LIBRARIES mvog_ros_conversions mvog_scene)
   # The core's promises about threads, and the server's lock pattern (also under TSan).
   mvog_add_gtest(test_concurrency
     SOURCES test/reliability/test_concurrency.cpp
@@ -130,7 +131,7 @@ if(TARGET mvog_bench)
   find_package(jsoncpp REQUIRED)
   mvog_add_gtest(test_mvog_bench
     SOURCES test/bench/test_bench_smoke.cpp
-    LIBRARIES JsonCpp::JsonCpp)
+    LIBRARIES JsonCpp::JsonCpp ${catkin_LIBRARIES})
   target_compile_definitions(test_mvog_bench PRIVATE
     MVOG_BENCH_EXECUTABLE="$<TARGET_FILE:mvog_bench>"
     MVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
