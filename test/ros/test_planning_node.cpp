@@ -133,6 +133,8 @@ mvog::CheckBoxes::Response checkBoxes(const std::vector<mvog::Box>& boxes) {
 std::vector<std::vector<float>> pointsOf(const sensor_msgs::PointCloud2& cloud,
                                          const std::vector<std::string>& fields) {
   std::vector<std::vector<float>> points(std::size_t{cloud.width} * cloud.height);
+  // sensor_msgs' iterators take data.front(), undefined on an empty cloud (UBSan reports it).
+  if (points.empty()) return points;
   for (const std::string& field : fields) {
     sensor_msgs::PointCloud2ConstIterator<float> value(cloud, field);
     for (std::vector<float>& point : points) point.push_back(*value), ++value;
