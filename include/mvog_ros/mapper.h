@@ -11,8 +11,10 @@
 #include "mvog_ros/publications/binary_map_publication.h"
 #include "mvog_ros/publications/grid_publication.h"
 #include "mvog_ros/publications/marker_publication.h"
+#include "mvog_ros/publications/planning_publication.h"
 #include "mvog_ros/publications/statistics_publication.h"
 #include "mvog_ros/services/map_file_services.h"
+#include "mvog_ros/services/planning_services.h"
 #include "mvog_ros/services/query_services.h"
 #include "mvog_ros/services/reset_service.h"
 #include "mvog_ros/shared_map.h"
@@ -23,8 +25,10 @@ namespace mvog_ros {
 /// (SharedMap) and composes the parts that use them, each with its slice of MapperConfig:
 ///   sensor inputs      subscribe, wait for tf, convert (SensorInputs: inputs/)
 ///   insertion worker   bounded queue and thread, the only writer of readings (InsertionWorker)
-///   publications       markers, grids, binary map, statistics (publications/)
-///   services           queries, map files and autosave, reset (services/)
+///   publications       markers, grids, frontiers and surfaces, binary map, statistics
+///                      (publications/)
+///   services           queries, segment and box checks, map files and autosave, reset
+///                      (services/)
 /// and decays the map itself. Callbacks may run on several threads at once.
 class Mapper {
  public:
@@ -51,8 +55,10 @@ class Mapper {
   InsertionWorker insertion_;
   MarkerPublication markers_;
   GridPublication grids_;
+  PlanningPublication frontiers_and_surfaces_;
   BinaryMapPublication binary_map_;
   QueryServices queries_;
+  PlanningServices checks_;
   MapFileServices map_files_;
   ros::Timer decay_timer_;
   SensorInputs inputs_;

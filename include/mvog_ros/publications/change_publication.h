@@ -1,6 +1,8 @@
 #pragma once
 
+#include <cstdint>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include <ros/ros.h>
@@ -10,8 +12,15 @@
 
 namespace mvog_ros {
 
-/// What MarkerPublication and GridPublication share: every ~publish_period they publish what
-/// changed in the map since they last did (the tiles modified since), and once the map was
+/// The tiles of `map` modified after `revision` and those removed after it (which hold nothing
+/// now), rows of tiles from the lowest; nothing if the map no longer knows which tiles it removed
+/// since then (Map::tilesRemovedSince).
+std::optional<std::vector<mvog::TileIndex>> tilesChangedSince(const mvog::Map& map,
+                                                              std::uint64_t revision);
+
+/// What MarkerPublication, GridPublication and PlanningPublication share: every ~publish_period
+/// they publish what changed in the map since they last did (the tiles modified or removed
+/// since: tilesChangedSince; all of them afresh if the map cannot tell), and once the map was
 /// replaced (~load_map, ~reset) they first clear what they showed of the previous one. Their
 /// connection callbacks take the same lock (mutex_, then the map's) to send a new subscriber
 /// everything.

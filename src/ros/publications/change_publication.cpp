@@ -1,8 +1,25 @@
 #include "mvog_ros/publications/change_publication.h"
 
+#include <algorithm>
+#include <iterator>
 #include <shared_mutex>
 
 namespace mvog_ros {
+
+std::optional<std::vector<mvog::TileIndex>> tilesChangedSince(const mvog::Map& map,
+                                                              std::uint64_t revision) {
+  const std::optional<std::vector<mvog::TileIndex>> removed = map.tilesRemovedSince(revision);
+  if (!removed) return std::nullopt;
+  const std::vector<mvog::TileIndex> modified = map.tilesModifiedSince(revision);
+  std::vector<mvog::TileIndex> changed;
+  changed.reserve(modified.size() + removed->size());
+  // Both lists are rows of tiles from the lowest, and no tile is in both.
+  std::merge(modified.begin(), modified.end(), removed->begin(), removed->end(),
+             std::back_inserter(changed), [](const mvog::TileIndex& a, const mvog::TileIndex& b) {
+               return a.y != b.y ? a.y < b.y : a.x < b.x;
+             });
+  return changed;
+}
 
 ChangePublication::ChangePublication(const SharedMap& shared_map) : map_(shared_map) {}
 
@@ -31,9 +48,14 @@ void ChangePublication::publishChanges(const ros::TimerEvent&) {
   std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
   restartIfReplacedLocked();
   if (map_.version() == published_) return;
-  const std::vector<mvog::TileIndex> changed = map_.map.tilesModifiedSince(published_.revision);
+  std::optional<std::vector<mvog::TileIndex>> changed =
+      tilesChangedSince(map_.map, published_.revision);
+  if (!changed) {  // the map no longer knows which tiles it removed: show it afresh
+    clearPublished();
+    changed = map_.map.tilesModifiedSince(0);
+  }
   published_ = map_.version();
-  publishTiles(changed);
+  publishTiles(*changed);
 }
 
 }  // namespace mvog_ros
