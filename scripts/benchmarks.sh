@@ -15,8 +15,7 @@ OUT=${1:-$WORKSPACE/benchmarks}
 REPEAT=${MVOG_BENCH_REPEAT:-3}
 install_missing_packages
 build_workspace
-# shellcheck disable=SC1091
-source "$WORKSPACE/devel/setup.bash"
+source_workspace
 BENCH=$WORKSPACE/devel/lib/mvog/mvog_bench
 [ -d "$MVOG_DATA_DIR" ] || { echo "no shared data at $MVOG_DATA_DIR (set MVOG_DATA_DIR)" >&2; exit 1; }
 mkdir -p "$OUT"
