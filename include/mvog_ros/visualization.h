@@ -59,8 +59,9 @@ class IncrementalGrid {
   IncrementalGrid(double z, std::int64_t max_cells, Compute compute)
       : z_(z), max_cells_(max_cells), compute_(std::move(compute)) {}
 
-  /// Brings the grid up to date with the tiles changed since the last update. Returns the
-  /// rectangle that changed (for an OccupancyGridUpdate), or the whole grid after a re-layout.
+  /// Brings the grid up to date with the tiles changed (modified or removed) since the last
+  /// update; tiles outside the layout are passed over. Returns the rectangle that changed (for an
+  /// OccupancyGridUpdate), or the whole grid after a re-layout.
   /// Throws GridTooLarge (and forgets the grid) if the map's bounds need more than max_cells.
   mvog::CellRange update(const mvog::Map& map, const std::vector<mvog::TileIndex>& changed,
                          bool& relaid_out);

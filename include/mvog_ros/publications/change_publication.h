@@ -1,6 +1,7 @@
 #pragma once
 
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include <ros/ros.h>
@@ -11,10 +12,11 @@
 namespace mvog_ros {
 
 /// What MarkerPublication and GridPublication share: every ~publish_period they publish what
-/// changed in the map since they last did (the tiles modified since), and once the map was
-/// replaced (~load_map, ~reset) they first clear what they showed of the previous one. Their
-/// connection callbacks take the same lock (mutex_, then the map's) to send a new subscriber
-/// everything.
+/// changed in the map since they last did (the tiles modified or removed since: forgetting, the
+/// window, ~clear_box), and once the map was replaced (~load_map, ~reset), or it cannot tell
+/// which tiles went (a mirror's full update), they first clear what they showed and publish every
+/// tile. Their connection callbacks take the same lock (mutex_, then the map's) to send a new
+/// subscriber everything.
 class ChangePublication {
  public:
   virtual ~ChangePublication();
@@ -34,6 +36,9 @@ class ChangePublication {
   void stop();
   /// Under mutex_ and the map's lock.
   void restartIfReplacedLocked();
+  /// The tiles removed, then those modified, since what the publication shows; nothing if the
+  /// map cannot tell which tiles it removed (under mutex_ and the map's lock).
+  std::optional<std::vector<mvog::TileIndex>> changedSincePublished() const;
 
   /// Clears what was published of the previous map (under mutex_ and the map's lock).
   virtual void clearPublished() = 0;

@@ -26,14 +26,27 @@ void ChangePublication::restartIfReplacedLocked() {
   published_ = {map_.generation, 0};
 }
 
+std::optional<std::vector<mvog::TileIndex>> ChangePublication::changedSincePublished() const {
+  std::optional<std::vector<mvog::TileIndex>> changed =
+      map_.map.tilesRemovedSince(published_.revision);
+  if (!changed) return std::nullopt;
+  const std::vector<mvog::TileIndex> modified = map_.map.tilesModifiedSince(published_.revision);
+  changed->insert(changed->end(), modified.begin(), modified.end());
+  return changed;
+}
+
 void ChangePublication::publishChanges(const ros::TimerEvent&) {
   std::lock_guard<std::mutex> publication_lock(mutex_);
   std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
   restartIfReplacedLocked();
   if (map_.version() == published_) return;
-  const std::vector<mvog::TileIndex> changed = map_.map.tilesModifiedSince(published_.revision);
+  std::optional<std::vector<mvog::TileIndex>> changed = changedSincePublished();
+  if (!changed) {
+    clearPublished();
+    changed = map_.map.tilesModifiedSince(0);
+  }
   published_ = map_.version();
-  publishTiles(changed);
+  publishTiles(*changed);
 }
 
 }  // namespace mvog_ros
