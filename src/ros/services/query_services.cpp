@@ -3,9 +3,9 @@
 #include <cmath>
 #include <shared_mutex>
 
-#include <tf2_eigen/tf2_eigen.h>
 #include <Eigen/Geometry>
 
+#include "mvog_ros/frames.h"
 #include "mvog_ros/visualization.h"
 
 namespace mvog_ros {
@@ -37,11 +37,9 @@ bool QueryServices::getOccupancy(mvog::GetOccupancy::Request& request,
   Eigen::Isometry3d map_from_frame = Eigen::Isometry3d::Identity();
   if (!request.frame_id.empty() && request.frame_id != frame_id_) {
     try {
-      map_from_frame = tf2::transformToEigen(tf_buffer_.lookupTransform(
-          frame_id_, request.frame_id, ros::Time(0), ros::Duration(config_.tf_timeout)));
-    } catch (const tf2::TransformException& e) {
-      response.message =
-          "cannot transform from '" + request.frame_id + "' to '" + frame_id_ + "': " + e.what();
+      map_from_frame = latestTransform(tf_buffer_, frame_id_, request.frame_id, config_.tf_timeout);
+    } catch (const TransformUnavailable& e) {
+      response.message = e.what();
       return true;
     }
   }
