@@ -15,10 +15,16 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
       grids_(private_nh, config_.publications, config_.frame_id, config_.occupancy_threshold,
              config_.max_cross_section_cells, map_),
       binary_map_(private_nh, config_.publications, config_.frame_id, map_),
+      map_updates_(private_nh, config_.publications, config_.frame_id, map_),
       queries_(private_nh, config_.queries, config_.frame_id, config_.occupancy_threshold,
                config_.max_cross_section_cells, config_.map.max_coordinate, map_, tf_buffer_),
       map_files_(private_nh, config_.map_files, map_,
                  [this](mvog::Map&& map) { replaceMap(std::move(map)); }),
+      map_edits_(private_nh, config_.frame_id, config_.queries.tf_timeout,
+                 config_.map_files.map_directory, map_, tf_buffer_),
+      window_(private_nh, config_.lifetime, config_.frame_id, config_.map_files.map_directory,
+              config_.publications.publish_period, map_, tf_buffer_,
+              [this] { return insertion_.latestOrigin(); }),
       inputs_(nh, config_.inputs, config_.frame_id, config_.insertion.max_range, tf_buffer_,
               [this](mvog::Scan&& scan, const std::string& source) {
                 insertion_.enqueue(std::move(scan), source);
@@ -43,6 +49,7 @@ Mapper::~Mapper() {
   inputs_.stop();
   decay_timer_.stop();
   insertion_.stop();
+  window_.stop();
   // A clean shutdown loses nothing mapped since the last autosave.
   map_files_.autosaveOnShutdown();
 }
@@ -59,6 +66,8 @@ void Mapper::replaceMap(mvog::Map&& map) {
 void Mapper::decay(const ros::TimerEvent&) {
   std::unique_lock<WriterPreferringMutex> lock(map_.mutex);
   map_.map.decay(config_.decay.decay_factor);
+  // Only decay makes volumes lighter: forgetting follows each step (~forget_mass 0: nothing).
+  map_.map.forget(config_.lifetime.forget_mass);
 }
 
 }  // namespace mvog_ros
