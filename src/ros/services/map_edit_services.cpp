@@ -59,8 +59,11 @@ mvog::GridTransform gridTransform(geometry_msgs::Transform map_from_other, doubl
   try {
     return mvog::GridTransform::fromMatrix(tf2::transformToEigen(map_from_other).matrix(),
                                            resolution);
-  } catch (const mvog::ConfigError& e) {
-    throw mvog::ConfigError("map_from_other: " + std::string(e.what()));
+  } catch (const mvog::ConfigError& e) {  // "transform: why"
+    std::string why = e.what();
+    const std::string core_prefix = "transform: ";
+    if (why.rfind(core_prefix, 0) == 0) why.erase(0, core_prefix.size());
+    throw mvog::ConfigError("map_from_other: " + why);
   }
 }
 
