@@ -116,6 +116,7 @@ add_rostest(test/reliability/overload.test DEPENDENCIES mvog_node)
 # A map's lifetime (test/lifecycle): ~clear_box and ~merge_map, the local window, mirrors.
 add_rostest(test/lifecycle/map_edits.test DEPENDENCIES mvog_node)
 add_rostest(test/lifecycle/window.test DEPENDENCIES mvog_node)
+add_rostest(test/lifecycle/mirror.test DEPENDENCIES mvog_node mvog_mirror)
 # Replays of the recordings in $MVOG_DATA_DIR (default ../shared/data) through mapper.launch,
 # checked against the data's README (test/data). Skipped without the data unless CI=true.
 add_rostest(test/data/newcollege.test)
