@@ -113,6 +113,20 @@ def main(out):
                  "Table I: MVOG", "Table I: OctoMap", "MVOG file", "OctoMap .ot file"], memory))
     print("\n### Threads (0.05 m)\n")
     print(table(["file", "1 thread (s)", "2 threads (s)", "speed-up", "same map"], threads))
+    instructions = []
+    for path in sorted(glob.glob(f"{out}/instructions_mvog_*")):
+        name = os.path.basename(path)[len("instructions_mvog_"):]
+        counts = {b: int(read_text(f"instructions_{b}_{name}"))
+                  for b in ("mvog", "octomap", "walk")}
+        instructions.append([
+            name, f"{counts['mvog'] / 1e6:,.0f} M", f"{counts['octomap'] / 1e6:,.0f} M",
+            f"{counts['walk'] / 1e6:,.0f} M", f"{counts['octomap'] / counts['mvog']:.2f}x",
+            f"{counts['mvog'] / counts['walk']:.2f}x",
+        ])
+    if instructions:
+        print("\n### Instructions retired by the insertion (callgrind, 0.05 m, one thread)\n")
+        print(table(["file", "MVOG", "OctoMap", "walk", "OctoMap / MVOG", "MVOG / walk"],
+                    instructions))
     microbench = f"{out}/microbench.json"
     if os.path.exists(microbench):
         print("\n### Micro-benchmarks (mvog_microbench)\n")

@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Every figure of BENCHMARKS.md, from a fresh clone: installs what is missing, builds (Release),
 # runs mvog_bench on every shared recording (MVOG, OctoMap and the bare walk on the same rays, in
-# one run per file), MVOG with 2 threads and with the paper's model, and mvog_microbench; writes
-# the outputs (JSON and text) to OUT and prints the report's tables (scripts/benchmark_tables.py).
-#   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~15 min here)
+# one run per file), MVOG with 2 threads and with the paper's model, mvog_microbench, and the
+# instruction counts of the three insertions (callgrind: the ratios the machine's load cannot
+# disturb); writes the outputs (JSON and text) to OUT and prints the report's tables
+# (scripts/benchmark_tables.py).
+#   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~25 min here)
 # MVOG_BENCH_REPEAT (default 3): insertions per backend, the fastest reported.
+# shellcheck source=scripts/common.sh
 source "$(dirname "$0")/common.sh"
 
 OUT=${1:-$WORKSPACE/benchmarks}
@@ -49,5 +52,21 @@ done
 echo "mvog_microbench -> $OUT/microbench.json"
 "$WORKSPACE/devel/lib/mvog/mvog_microbench" --benchmark_out="$OUT/microbench.json" \
   --benchmark_out_format=json >"$OUT/microbench.txt" 2>&1
+# count_instructions FILE BACKEND FUNCTION: the instructions retired inside FUNCTION (callgrind's
+# --toggle-collect) while mvog_bench inserts FILE at 0.05 m with BACKEND alone.
+count_instructions() {
+  local name=$2_$1
+  echo "callgrind: $2 on $1 -> $OUT/instructions_$name"
+  valgrind --tool=callgrind --callgrind-out-file="$OUT/callgrind_$name.out" \
+    --toggle-collect="$3" "$BENCH" --input "$MVOG_DATA_DIR/$1" --resolution 0.05 --backend "$2" \
+    >"$OUT/callgrind_$name.log" 2>&1
+  callgrind_annotate "$OUT/callgrind_$name.out" |
+    awk '/PROGRAM TOTALS/ { gsub(",", "", $1); print $1; exit }' >"$OUT/instructions_$name"
+}
+for file in kurt3d_3scans.graph tum_fr2_pioneer_slam2_10frames.graph; do
+  count_instructions "$file" mvog 'mvog::Map::insertScan*'
+  count_instructions "$file" walk 'mvog_bench::runWalk*'
+  count_instructions "$file" octomap 'octomap::OccupancyOcTreeBase*::insertPointCloud*'
+done
 cut -d' ' -f1-3 /proc/loadavg >"$OUT/load_average_after"
 python3 "$REPO/scripts/benchmark_tables.py" "$OUT" | tee "$OUT/tables.md"

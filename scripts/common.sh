@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # Shared by scripts/demo.sh and scripts/test.sh: installs what is missing and builds, quietly.
 # Source it; it defines REPO, WORKSPACE and the functions below.
 set -euo pipefail
@@ -11,16 +12,18 @@ LOG_DIR=$WORKSPACE/logs
 export MVOG_DATA_DIR=${MVOG_DATA_DIR:-$(cd "$REPO/.." && pwd)/shared/data}
 
 # Debian 12 packages: ROS 1 (Debian's own build), PCL, OctoMap, test and headless-rviz tools,
-# clang with its sanitizer and libFuzzer runtimes (scripts/sanitizers.sh).
+# valgrind (scripts/benchmarks.sh's instruction counts), clang with its sanitizer and libFuzzer
+# runtimes (scripts/sanitizers.sh), the linters (scripts/lint.sh).
 MVOG_PACKAGES=(
   build-essential cmake libeigen3-dev libgtest-dev libbenchmark-dev
   ros-core-python-dev ros-base-dev python3-rostest rosbash python3-rosbag python3-numpy
   python3-rospy python3-sensor-msgs python3-geometry-msgs python3-tf2-msgs python3-tf2-ros
   libpcl-dev libtf2-ros-dev libtf2-eigen-dev libtf2-msgs-dev libstd-srvs-dev
   libvisualization-msgs-dev libnav-msgs-dev libmap-msgs-dev libdiagnostic-updater-dev
+  libimage-transport-dev
   rviz tf2-tools liboctomap-dev octomap-tools
-  xvfb xauth x11-utils libgl1-mesa-dri imagemagick
-  clang-14 libclang-rt-14-dev clang-format-14
+  xvfb xauth x11-utils libgl1-mesa-dri imagemagick valgrind
+  clang-14 libclang-rt-14-dev clang-format-14 clang-tidy-14 catkin-lint shellcheck
 )
 
 as_root() {
@@ -52,11 +55,14 @@ install_missing_packages() {
     --no-install-recommends "${missing[@]}"
 }
 
-# The catkin workspace links the repository as its only package. Arguments go to catkin_make.
+# The catkin workspace links the repository as its only package (catkin's default
+# CATKIN_ENABLE_TESTING=ON declares the tests; `catkin_make run_tests` builds them). Its compile
+# commands are what scripts/lint.sh gives clang-tidy.
 build_workspace() {
   mkdir -p "$WORKSPACE/src"
   ln -sfn "$REPO" "$WORKSPACE/src/mvog"
-  (cd "$WORKSPACE" && quietly catkin_make catkin_make -DCMAKE_BUILD_TYPE=Release -j2 "$@")
+  (cd "$WORKSPACE" && quietly catkin_make catkin_make -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_EXPORT_COMPILE_COMMANDS=ON -j2)
 }
 
 source_workspace() {

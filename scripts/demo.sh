@@ -6,13 +6,16 @@
 # rendered PNG of the occupied space and a screenshot of rviz (under Xvfb) framed on the map, and
 # prints what the mapper did with the bag's sensor messages and the line to source to use it.
 #
-#   scripts/demo.sh [--bag FILE] [--scan-topic T] [--cloud-topic T] [--resolution R]
-#                   [--config YAML] [--heights "Z1 Z2"] [--rate X] [--output DIR]
+#   scripts/demo.sh [--bag FILE] [--scan-topic T] [--cloud-topic T] [--depth-topic T]
+#                   [--resolution R] [--config YAML] [--heights "Z1 Z2"] [--rate X] [--output DIR]
+# (--depth-topic: a depth image topic, its camera info on the sibling camera_info topic.)
+# shellcheck source=scripts/common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 bag=""
 scan_topic=/scan
 cloud_topic=/camera/depth/points
+depth_topic=/camera/depth/image
 resolution=0.05
 config=$REPO/config/demo.yaml
 heights="0.5 1.5"
@@ -23,18 +26,21 @@ while [ $# -gt 0 ]; do
     --bag) bag=$(realpath "$2"); shift 2 ;;
     --scan-topic) scan_topic=$2; shift 2 ;;
     --cloud-topic) cloud_topic=$2; shift 2 ;;
+    --depth-topic) depth_topic=$2; shift 2 ;;
     --resolution) resolution=$2; shift 2 ;;
     --config) config=$(realpath "$2"); shift 2 ;;
     --heights) heights=$2; shift 2 ;;
     --rate) rate=$2; shift 2 ;;
     --output) output=$2; shift 2 ;;
-    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
     *) echo "unknown option: $1 (see --help)" >&2; exit 2 ;;
   esac
 done
 # Topics as a bag names them.
 [[ $scan_topic == /* ]] || scan_topic=/$scan_topic
 [[ $cloud_topic == /* ]] || cloud_topic=/$cloud_topic
+[[ $depth_topic == /* ]] || depth_topic=/$depth_topic
+depth_info_topic=${depth_topic%/*}/camera_info  # image_transport's sibling
 read -r -a height_list <<<"$heights"
 
 install_missing_packages
@@ -52,19 +58,21 @@ if [ -z "$bag" ]; then
   fi
 fi
 
-# The bag's sensor messages on the two topics, and how long it plays.
-read -r bag_scans bag_clouds bag_seconds < <(python3 - "$bag" "$scan_topic" "$cloud_topic" <<'PY'
+# The bag's sensor messages on the three topics, and how long it plays.
+read -r bag_scans bag_clouds bag_images bag_seconds < <(python3 - "$bag" "$scan_topic" \
+  "$cloud_topic" "$depth_topic" <<'PY'
 import sys
 import rosbag
 with rosbag.Bag(sys.argv[1]) as bag:
     topics = bag.get_type_and_topic_info().topics
-    counts = [topics[t].message_count if t in topics else 0 for t in sys.argv[2:4]]
-    print(counts[0], counts[1], bag.get_end_time() - bag.get_start_time())
+    counts = [topics[t].message_count if t in topics else 0 for t in sys.argv[2:5]]
+    print(*counts, bag.get_end_time() - bag.get_start_time())
 PY
 )
-bag_messages=$((bag_scans + bag_clouds))
+bag_messages=$((bag_scans + bag_clouds + bag_images))
 if [ "$bag_messages" -eq 0 ]; then
-  echo "$bag holds no message on $scan_topic or $cloud_topic (see --scan-topic, --cloud-topic)" >&2
+  echo "$bag holds no message on $scan_topic, $cloud_topic or $depth_topic" \
+    "(see --scan-topic, --cloud-topic, --depth-topic)" >&2
   exit 1
 fi
 
@@ -72,7 +80,8 @@ start_private_master demo
 
 heights_yaml="[$(IFS=,; echo "${height_list[*]}")]"
 roslaunch mvog mapper.launch use_sim_time:=true resolution:="$resolution" \
-  scan_topic:="$scan_topic" cloud_topic:="$cloud_topic" map_directory:="$output" \
+  scan_topic:="$scan_topic" cloud_topic:="$cloud_topic" depth_topic:="$depth_topic" \
+  map_directory:="$output" \
   config:="$config" cross_section_heights:="$heights_yaml" >"$LOG_DIR/demo-mapper.log" 2>&1 &
 BACKGROUND_PIDS+=($!)
 until rosservice list 2>/dev/null | grep -q /mvog_mapper/save_map; do
@@ -89,9 +98,10 @@ echo "replaying $bag ..."
 # message is lost. --keep-alive keeps the clock going past the bag's end, so that the mapper's
 # timers (statistics, publication, decay) run on while it inserts what it still holds.
 rosbag play --clock --keep-alive --wait-for-subscribers -q -r "$rate" "$bag" \
-  --topics "$scan_topic" "$cloud_topic" /tf /tf_static >"$LOG_DIR/demo-rosbag.log" 2>&1 &
+  --topics "$scan_topic" "$cloud_topic" "$depth_topic" "$depth_info_topic" /tf /tf_static \
+  >"$LOG_DIR/demo-rosbag.log" 2>&1 &
 player=$!
-BACKGROUND_PIDS+=($player)
+BACKGROUND_PIDS+=("$player")
 # Until the statistics account for every sensor message of the bag (inserted or dropped for a
 # reason they count); messages lost uncounted would keep them short, so also until they have
 # stood still for 10 s once the bag has played.
@@ -112,7 +122,7 @@ while time.monotonic() - start < play_seconds + 600:
         continue
     s = latest[-1]
     now = (s.messages_inserted, s.messages_dropped_tf, s.messages_dropped_queue,
-           s.messages_dropped_invalid)
+           s.messages_dropped_invalid, s.messages_dropped_camera_info)
     if now != counts:
         counts, changed = now, time.monotonic()
     if sum(counts) >= expected:
@@ -134,11 +144,11 @@ rosrun mvog mvog_export "$map" "${export_args[@]}" >"$LOG_DIR/demo-export.log"
 
 # rviz's view framed on the map (its extent from the projected map), for the screenshot and for
 # `rviz -d $output/mvog.rviz`.
-python3 - "$REPO/rviz/mvog.rviz" "$output/projected_map" "$scan_topic" "$cloud_topic" \
+python3 - "$REPO/rviz/mvog.rviz" "$output/projected_map" "$scan_topic" "$depth_topic" \
   >"$output/mvog.rviz" <<'PY'
 import re
 import sys
-template, projection, scan_topic, cloud_topic = sys.argv[1:5]
+template, projection, scan_topic, depth_topic = sys.argv[1:5]
 resolution = origin = None
 for line in open(projection + ".yaml"):
     if line.startswith("resolution:"):
@@ -155,7 +165,7 @@ text = open(template).read()
 text = re.sub(r"Distance: [-0-9.]+\n      Focal Point:\n        X: [-0-9.]+\n        Y: [-0-9.]+\n",
               view, text)
 text = text.replace("Topic: /scan\n", "Topic: %s\n" % scan_topic)
-text = text.replace("Topic: /camera/depth/points\n", "Topic: %s\n" % cloud_topic)
+text = text.replace("Depth Map Topic: /camera/depth/image\n", "Depth Map Topic: %s\n" % depth_topic)
 sys.stdout.write(text)
 PY
 
@@ -184,9 +194,11 @@ echo
 rostopic echo -n 1 /mvog_mapper/statistics >"$LOG_DIR/demo-statistics.log" 2>/dev/null
 statistic() { sed -n "s/^$1: //p" "$LOG_DIR/demo-statistics.log"; }
 echo "sensor messages in the bag: $bag_messages ($bag_scans LaserScan on $scan_topic," \
-  "$bag_clouds PointCloud2 on $cloud_topic); inserted $(statistic messages_inserted)," \
-  "dropped $(statistic messages_dropped_tf) without transform," \
-  "$(statistic messages_dropped_queue) for a full queue, $(statistic messages_dropped_invalid) invalid"
+  "$bag_clouds PointCloud2 on $cloud_topic, $bag_images depth images on $depth_topic);" \
+  "inserted $(statistic messages_inserted), dropped $(statistic messages_dropped_tf) without" \
+  "transform, $(statistic messages_dropped_queue) for a full queue," \
+  "$(statistic messages_dropped_invalid) invalid, $(statistic messages_dropped_camera_info)" \
+  "without camera info"
 echo "statistics:"
 grep -E 'cells_with_volumes|_volumes|bytes_held|table_one|readings_inserted|readings_rejected|insertion_seconds' \
   "$LOG_DIR/demo-statistics.log" | sed 's/^/  /'

@@ -4,7 +4,9 @@
 A depth sensor turns and moves in a closed 20 m x 12 m x 3 m room: every message is a
 PointCloud2 of --points points (float32 x, y, z in the sensor frame, 1 cm noise) published at
 --rate Hz for --duration s, with its pose on /tf (map -> load_sensor, stamped like the cloud) at
-twice that rate. Meanwhile a client asks ~get_occupancy for --query-points random points of the
+twice that rate. With --depth WIDTHxHEIGHT the sensor is a depth camera instead (Kinect-like
+intrinsics, 1 cm noise): every message is a depth image of --depth-encoding with its camera info,
+in the optical frame load_sensor_optical (a static transform from load_sensor). Meanwhile a client asks ~get_occupancy for --query-points random points of the
 room at --query-rate Hz. The script starts its own mvog_node (the server's defaults but for
 --resolution, --max-range and --insertion-threads) and reports:
 
@@ -28,7 +30,9 @@ import time
 import numpy as np
 import rospy
 from geometry_msgs.msg import Point
+from geometry_msgs.msg import TransformStamped
 from tf2_msgs.msg import TFMessage
+import tf2_ros
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "test",
                                 "reliability"))
@@ -38,12 +42,17 @@ from mvog.srv import GetOccupancy  # noqa: E402
 ROOM_MIN = np.array([-10.0, -6.0, 0.0])
 ROOM_MAX = np.array([10.0, 6.0, 3.0])
 SENSOR_FRAME = "load_sensor"
+OPTICAL_FRAME = "load_sensor_optical"  # x right, y down, z forward
 
 
 def arguments():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--points", type=int, default=300000, help="points per cloud")
-    parser.add_argument("--rate", type=float, default=30.0, help="clouds per second")
+    parser.add_argument("--depth", metavar="WIDTHxHEIGHT",
+                        help="publish depth images of this size instead of clouds")
+    parser.add_argument("--depth-encoding", choices=("16UC1", "32FC1"), default="16UC1")
+    parser.add_argument("--depth-stride", type=int, default=1, help="the server's ~depth_stride")
+    parser.add_argument("--rate", type=float, default=30.0, help="messages per second")
     parser.add_argument("--duration", type=float, default=60.0, help="s of publishing")
     parser.add_argument("--query-points", type=int, default=10000)
     parser.add_argument("--query-rate", type=float, default=10.0)
@@ -60,6 +69,22 @@ def sensor_pose(t):
     angle = 0.08 * t
     position = np.array([6.0 * np.cos(angle), 3.0 * np.sin(angle), 1.2 + 0.4 * np.sin(0.3 * t)])
     return position, 0.5 * t
+
+
+def room_distances(directions, position, yaw):
+    """Distance along each unit direction (N, 3) of the sensor frame (float32) to the room's
+    walls, floor and ceiling, the sensor at `position` turned by `yaw`."""
+    c, s = np.float32(np.cos(yaw)), np.float32(np.sin(yaw))
+    x, y, z = directions.T
+    world = (c * x - s * y, s * x + c * y, z)
+    distance = None
+    for axis in range(3):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            to_wall = np.where(world[axis] > 0, np.float32(ROOM_MAX[axis] - position[axis]),
+                               np.float32(ROOM_MIN[axis] - position[axis])) / world[axis]
+        to_wall[~(to_wall > 0)] = np.inf
+        distance = to_wall if distance is None else np.minimum(distance, to_wall)
+    return distance
 
 
 class RaySet:
@@ -79,17 +104,48 @@ class RaySet:
     def room_cloud(self, position, yaw):
         """The room's walls, floor and ceiling where the rays hit them, in the sensor frame, as
         the bytes of float32 x, y, z."""
-        c, s = np.float32(np.cos(yaw)), np.float32(np.sin(yaw))
-        x, y, z = self.directions.T
-        world = (c * x - s * y, s * x + c * y, z)
-        distance = None
-        for axis in range(3):
-            with np.errstate(divide="ignore", invalid="ignore"):
-                to_wall = np.where(world[axis] > 0, np.float32(ROOM_MAX[axis] - position[axis]),
-                                   np.float32(ROOM_MIN[axis] - position[axis])) / world[axis]
-            to_wall[~(to_wall > 0)] = np.inf
-            distance = to_wall if distance is None else np.minimum(distance, to_wall)
+        distance = room_distances(self.directions, position, yaw)
         return (self.directions * (distance + self.noise)[:, None]).tobytes()
+
+
+class DepthCamera:
+    """A depth camera of width x height pixels looking along the sensor's +x, fx = fy = 525
+    pixels at 640 wide (a Kinect's 62 x 49 degrees), with a range noise (1 cm) per pixel."""
+
+    def __init__(self, width, height, encoding, seed):
+        self.width, self.height, self.encoding = width, height, encoding
+        self.f = 525.0 * width / 640.0
+        self.cx, self.cy = (width - 1) / 2.0, (height - 1) / 2.0
+        u, v = np.meshgrid(np.arange(width), np.arange(height))
+        optical = np.stack([(u.ravel() - self.cx) / self.f, (v.ravel() - self.cy) / self.f,
+                            np.ones(width * height)], axis=1)
+        self.depth_per_range = (1.0 / np.linalg.norm(optical, axis=1)).astype(np.float32)
+        unit = optical * self.depth_per_range[:, None]
+        # The optical frame's x right, y down, z forward in the sensor's x forward, y left, z up.
+        self.directions = np.stack([unit[:, 2], -unit[:, 0], -unit[:, 1]],
+                                   axis=1).astype(np.float32)
+        self.noise = np.random.default_rng(seed).normal(0.0, 0.01, width * height).astype(
+            np.float32)
+
+    def room_image(self, position, yaw):
+        """The depth image's bytes (16UC1 millimetres or 32FC1 metres) of the room."""
+        depth = (room_distances(self.directions, position, yaw) + self.noise) * self.depth_per_range
+        if self.encoding == "16UC1":
+            return (depth * 1000.0 + 0.5).astype("<u2").tobytes()
+        return depth.astype("<f4").tobytes()
+
+    def camera_info(self, image):
+        return rel.camera_info(image, fx=self.f, fy=self.f, cx=self.cx, cy=self.cy)
+
+
+def optical_frame_transform():
+    """load_sensor -> load_sensor_optical: the optical axes (REP-103's camera convention)."""
+    t = TransformStamped()
+    t.header.frame_id = SENSOR_FRAME
+    t.child_frame_id = OPTICAL_FRAME
+    t.transform.rotation.x, t.transform.rotation.y = -0.5, 0.5
+    t.transform.rotation.z, t.transform.rotation.w = -0.5, 0.5
+    return t
 
 
 class Sampler(threading.Thread):
@@ -150,21 +206,31 @@ def main():
     rospy.init_node("mvog_load_test", disable_signals=True)
     server = rel.Server("mvog_load", {"resolution": args.resolution, "max_range": args.max_range,
                                       "insertion_threads": args.insertion_threads,
+                                      "depth_stride": args.depth_stride,
                                       "statistics_period": 1.0, "publish_period": 1.0,
                                       "binary_map_period": 5.0}).wait_ready()
     sampler = Sampler(server, args.sample_period)
     querier = Querier(server, args.query_points, args.query_rate)
     try:
         tf_publisher = rospy.Publisher("/tf", TFMessage, queue_size=100)
-        ray_sets = [RaySet(args.points, seed) for seed in range(4)]
-        template = rel.cloud([], width=args.points, frame=SENSOR_FRAME,
-                             data=bytes(12 * args.points))
+        if args.depth:
+            width, height = (int(v) for v in args.depth.split("x"))
+            cameras = [DepthCamera(width, height, args.depth_encoding, seed) for seed in range(4)]
+            template = rel.depth_image([0] * (width * height), width,
+                                       encoding=args.depth_encoding, frame=OPTICAL_FRAME)
+            static_broadcaster = tf2_ros.StaticTransformBroadcaster()
+            static_broadcaster.sendTransform(optical_frame_transform())
+            what = "%dx%d %s depth images" % (width, height, args.depth_encoding)
+        else:
+            ray_sets = [RaySet(args.points, seed) for seed in range(4)]
+            template = rel.cloud([], width=args.points, frame=SENSOR_FRAME,
+                                 data=bytes(12 * args.points))
+            what = "%d-point clouds" % args.points
         before = server.stats()
         sampler.start()
         querier.start()
-        print("publishing %d-point clouds at %.0f Hz for %.0f s, querying %d points at %.0f Hz"
-              " ..." % (args.points, args.rate, args.duration, args.query_points, args.query_rate),
-              flush=True)
+        print("publishing %s at %.0f Hz for %.0f s, querying %d points at %.0f Hz ..."
+              % (what, args.rate, args.duration, args.query_points, args.query_rate), flush=True)
         published, skipped, slot = 0, 0, 0
         start = time.monotonic()
         while slot < args.duration * args.rate:
@@ -186,8 +252,14 @@ def main():
             transform = rel.transform("map", SENSOR_FRAME, *position, yaw=yaw, stamp=stamp)
             tf_publisher.publish(TFMessage([transform]))
             template.header.stamp = stamp
-            template.data = ray_sets[published % len(ray_sets)].room_cloud(position, yaw)
-            server.clouds.publish(template)
+            if args.depth:
+                camera = cameras[published % len(cameras)]
+                template.data = camera.room_image(position, yaw)
+                server.camera_infos.publish(camera.camera_info(template))
+                server.depth_images.publish(template)
+            else:
+                template.data = ray_sets[published % len(ray_sets)].room_cloud(position, yaw)
+                server.clouds.publish(template)
             published += 1
             # A second pose between clouds, so that tf interpolates (poses at twice the rate).
             half = stamp + rospy.Duration(0.5 / args.rate)
@@ -221,14 +293,18 @@ def main():
     dropped_queue = final.messages_dropped_queue - before.messages_dropped_queue
     dropped_tf = final.messages_dropped_tf - before.messages_dropped_tf
     dropped_invalid = final.messages_dropped_invalid - before.messages_dropped_invalid
-    counted = inserted + dropped_queue + dropped_tf + dropped_invalid
+    dropped_camera_info = (final.messages_dropped_camera_info
+                           - before.messages_dropped_camera_info)
+    counted = inserted + dropped_queue + dropped_tf + dropped_invalid + dropped_camera_info
     readings = final.readings_inserted - before.readings_inserted
     insertion_seconds = final.insertion_seconds - before.insertion_seconds
     figures = {
-        "points_per_cloud": args.points, "cloud_rate_hz": args.rate, "resolution": args.resolution,
+        "messages": what, "points_per_cloud": None if args.depth else args.points,
+        "cloud_rate_hz": args.rate, "resolution": args.resolution,
         "published": published, "slots_skipped": skipped, "publishing_seconds": publishing_seconds,
         "messages_inserted": inserted, "messages_dropped_queue": dropped_queue,
         "messages_dropped_tf": dropped_tf, "messages_dropped_invalid": dropped_invalid,
+        "messages_dropped_camera_info": dropped_camera_info,
         "messages_lost_uncounted": published - counted,
         "readings_inserted_per_second": readings / publishing_seconds,
         "readings_per_insertion_second": readings / insertion_seconds if insertion_seconds else 0,
@@ -241,11 +317,11 @@ def main():
         "rss_end_mb": rss_end, "bytes_held_end_mb": final.bytes_held / 1e6,
         "memory": sampler.rows, "server_alive": alive,
     }
-    print("\nclouds: %d published in %.1f s (%d slots skipped: publisher too slow), %d inserted, "
+    print("\n%s: %d published in %.1f s (%d slots skipped: publisher too slow), %d inserted, "
           "%d dropped from the insertion queue (counted), %d dropped waiting for tf, %d invalid, "
-          "%d lost uncounted"
-          % (published, publishing_seconds, skipped, inserted, dropped_queue, dropped_tf,
-             dropped_invalid, published - counted))
+          "%d without camera info, %d lost uncounted"
+          % (what, published, publishing_seconds, skipped, inserted, dropped_queue, dropped_tf,
+             dropped_invalid, dropped_camera_info, published - counted))
     print("readings inserted: %.0f per second of publishing, %.0f per second of insertion"
           % (figures["readings_inserted_per_second"], figures["readings_per_insertion_second"]))
     print("queries of %d points: %d, %d failed; latency p50 %.3f s, p99 %.3f s, max %.3f s; "

@@ -32,7 +32,7 @@ Vehicle and sensors
   0.05 m below base_link, pitched 10 deg down. 176 x 144 pixels over
   43.6 x 34.6 deg (by default --pixel-step 2 keeps every other pixel:
   88 x 72), 0.3-8 m, 1 cm range noise, --camera-rate Hz (default 2, which
-  keeps the default bag near 8 MB).
+  keeps the default bag near 4 MB).
   laser: 0.08 m ahead of and 0.06 m above base_link, pitched 30 deg down so the
   scan plane sweeps the room in 3D; 270 deg in 0.5 deg steps, 0.1-10 m,
   1 cm range noise, 20 Hz.
@@ -45,9 +45,11 @@ Topics (stamps from 1700000000 s; the bag's time of each message is its stamp)
   /tf                   tf2_msgs/TFMessage       map -> base_link at 50 Hz, from the
                                                  start to the end: every sensor stamp has
                                                  samples before and after it
-  /camera/depth/points  sensor_msgs/PointCloud2  organized, fields x y z float32 in the
-                                                 camera frame, NaN where there is no
-                                                 return
+  /camera/depth/image   sensor_msgs/Image        32FC1 depth (m along the optical axis) in
+                                                 the camera frame, +Inf where there is no
+                                                 return (REP-118)
+  /camera/depth/camera_info  sensor_msgs/CameraInfo  its pinhole camera (K, P; no distortion),
+                                                 same stamp
   /scan                 sensor_msgs/LaserScan    +Inf where there is no return (REP-117)
 
 Truth file (--truth FILE, JSON)
@@ -72,7 +74,7 @@ import numpy as np
 import rosbag
 import rospy
 from geometry_msgs.msg import TransformStamped
-from sensor_msgs.msg import LaserScan, PointCloud2, PointField
+from sensor_msgs.msg import CameraInfo, Image, LaserScan
 from tf2_msgs.msg import TFMessage
 
 START_SEC = 1_700_000_000
@@ -289,9 +291,10 @@ class Mount:
 
 
 class DepthCamera:
-    """Swissranger SR4000-like time-of-flight camera publishing organized clouds."""
+    """Swissranger SR4000-like time-of-flight camera publishing depth images (REP-118)."""
 
-    TOPIC = "/camera/depth/points"
+    TOPIC = "/camera/depth/image"
+    INFO_TOPIC = "/camera/depth/camera_info"
     FRAME = "camera_depth_optical_frame"
     NATIVE_WIDTH, NATIVE_HEIGHT = 176, 144
     HFOV, VFOV = math.radians(43.6), math.radians(34.6)
@@ -324,29 +327,38 @@ class DepthCamera:
     def beam_range(local):
         return np.linalg.norm(local, axis=-1)
 
-    def message(self, stamp, ranges):
-        points = (self.directions * ranges[:, None]).astype("<f4")
-        points[~np.isfinite(ranges)] = np.nan
-        cloud = PointCloud2()
-        cloud.header.stamp = stamp
-        cloud.header.frame_id = self.FRAME
-        cloud.height, cloud.width = self.height, self.width
-        cloud.fields = [PointField(name, 4 * i, PointField.FLOAT32, 1)
-                        for i, name in enumerate("xyz")]
-        cloud.is_bigendian = False
-        cloud.point_step = 12
-        cloud.row_step = 12 * self.width
-        cloud.is_dense = False
-        cloud.data = points.tobytes()
-        return cloud
+    def messages(self, stamp, ranges):
+        """The depth image of the ranges (depth = range x the ray's optical-axis component; +Inf
+        where there is no return) and its camera info."""
+        image = Image()
+        image.header.stamp = stamp
+        image.header.frame_id = self.FRAME
+        image.height, image.width = self.height, self.width
+        image.encoding = "32FC1"
+        image.is_bigendian = False
+        image.step = 4 * self.width
+        image.data = (ranges * self.directions[:, 2]).astype("<f4").tobytes()
+        info = CameraInfo()
+        info.header = image.header
+        info.height, info.width = self.height, self.width
+        info.distortion_model = "plumb_bob"
+        info.D = [0.0] * 5
+        # Pixel (u, v)'s centre is the image coordinate (u, v) (REP-104): the rays above leave
+        # through u + 0.5 from the image's edge.
+        cx, cy = self.width / 2.0 - 0.5, self.height / 2.0 - 0.5
+        info.K = [self.fx, 0.0, cx, 0.0, self.fy, cy, 0.0, 0.0, 1.0]
+        info.R = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+        info.P = [self.fx, 0.0, cx, 0.0, 0.0, self.fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
+        return [(self.TOPIC, image), (self.INFO_TOPIC, info)]
 
     def to_json(self):
-        return {"topic": self.TOPIC, "frame_id": self.FRAME, "type": "sensor_msgs/PointCloud2",
+        return {"topic": self.TOPIC, "camera_info_topic": self.INFO_TOPIC, "frame_id": self.FRAME,
+                "type": "sensor_msgs/Image", "encoding": "32FC1",
                 "rate_hz": self.rate_hz, "width": self.width, "height": self.height,
                 "hfov_deg": round(math.degrees(self.HFOV), 3),
                 "vfov_deg": round(math.degrees(self.VFOV), 3),
                 "range_min": self.RANGE_MIN, "range_max": self.RANGE_MAX,
-                "noise_std": self.NOISE_STD, "no_return": "NaN"}
+                "noise_std": self.NOISE_STD, "no_return": "+Inf"}
 
 
 class TiltedLaser:
@@ -379,7 +391,7 @@ class TiltedLaser:
     def beam_range(local):
         return np.hypot(local[..., 0], local[..., 1])
 
-    def message(self, stamp, ranges):
+    def messages(self, stamp, ranges):
         scan = LaserScan()
         scan.header.stamp = stamp
         scan.header.frame_id = self.FRAME
@@ -390,7 +402,7 @@ class TiltedLaser:
         scan.scan_time = 1.0 / self.RATE_HZ
         scan.range_min, scan.range_max = self.RANGE_MIN, self.RANGE_MAX
         scan.ranges = ranges.astype(np.float32).tolist()
-        return scan
+        return [(self.TOPIC, scan)]
 
     def to_json(self):
         return {"topic": self.TOPIC, "frame_id": self.FRAME, "type": "sensor_msgs/LaserScan",
@@ -649,9 +661,9 @@ def write_bag(path, scene, recordings, tf_times):
             [transform(stamp, FIXED_FRAME, BASE_FRAME, rot_z(yaw), position)])))
     for recording in recordings:
         for t, ranges in zip(recording.times, recording.ranges):
-            message = recording.sensor.message(stamp_at(t), ranges)
-            events.append((t, recording.sensor.TOPIC, message))
-    events.sort(key=lambda event: event[0])
+            for topic, message in recording.sensor.messages(stamp_at(t), ranges):
+                events.append((t, topic, message))
+    events.sort(key=lambda event: event[0])  # stable: a camera info right after its image
     with rosbag.Bag(path, "w") as bag:
         bag.write(TF_STATIC_TOPIC, static_tf, static_stamp,
                   connection_header=latched_header(TF_STATIC_TOPIC, TFMessage))

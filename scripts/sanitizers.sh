@@ -14,6 +14,7 @@
 # Called by scripts/test.sh; runs alone too. The last line is
 #   sanitizers: N passed, N failed, N skipped
 # (one check per test program or fuzz run); exits non-zero if any failed.
+# shellcheck source=scripts/common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 install_missing_packages
@@ -101,6 +102,7 @@ in_asan_workspace() {
 }
 asan_ros_tests=(mapper_node decay bad_input time_jump kill_during_save overload)
 mkdir -p "$asan_workspace/src"
+# shellcheck disable=SC2031 # in_asan_workspace's subshell sources setup.bash, unseen: not REPO
 ln -sfn "$REPO" "$asan_workspace/src/mvog"
 if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS="$sanitize -fno-omit-frame-pointer" \
@@ -121,6 +123,7 @@ else
   fail "tsan-concurrency: the thread build failed"
 fi
 
+# shellcheck disable=SC2031 # as above
 if build fuzz clang++-14 "${fuzz_targets[@]/#/fuzz_}"; then
   for target in "${fuzz_targets[@]}"; do
     # New inputs go to the first directory (kept between local runs); the others only seed.

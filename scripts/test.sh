@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds (Release) and runs every test: a formatting check, the core
-# alone with plain CMake (no ROS), then the catkin package's gtests and rostests, then the
-# sanitizer builds and fuzzing (scripts/sanitizers.sh). Prints one summary line and exits
+# alone with plain CMake (no ROS), then the catkin package's gtests and rostests, the linters
+# (catkin_lint, shellcheck, clang-tidy: scripts/lint.sh), then the sanitizer builds and fuzzing
+# (scripts/sanitizers.sh). Prints one summary line and exits
 # non-zero on any failure. Tests that replay ../shared/data skip without it, but not when CI=true.
+# shellcheck source=scripts/common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 install_missing_packages
@@ -37,7 +39,7 @@ passed=$((passed + ${core_total:-0} - ${core_failed:-0}))
 failed=$((failed + ${core_failed:-1}))
 
 # 2. The catkin package: gtests and rostests.
-build_workspace -DCATKIN_ENABLE_TESTING=ON
+build_workspace
 source_workspace
 rm -rf "$WORKSPACE/build/test_results"
 quietly run-tests bash -c "cd '$WORKSPACE' && catkin_make run_tests -j2" || true
@@ -54,17 +56,26 @@ if [ $((errors + test_failures)) -gt 0 ] || [ "$tests" -eq 0 ]; then
   failures+=("catkin tests: $(grep -vE '^Summary:' <<<"$results" | grep -E 'errors|failures|Error' | head -20)")
 fi
 
-# 3. Sanitizer builds and fuzzing: ASan + UBSan, TSan, libFuzzer (scripts/sanitizers.sh).
-bash "$REPO/scripts/sanitizers.sh" >"$LOG_DIR/sanitizers.log" 2>&1 || true
-sanitizer_counts=$(sed -nE 's/^sanitizers: ([0-9]+) passed, ([0-9]+) failed, ([0-9]+) skipped$/\1 \2 \3/p' \
-  "$LOG_DIR/sanitizers.log")
-read -r san_passed san_failed san_skipped <<<"${sanitizer_counts:-0 1 0}"
-passed=$((passed + san_passed))
-failed=$((failed + san_failed))
-skipped=$((skipped + san_skipped))
-if [ "$san_failed" -gt 0 ]; then
-  failures+=("sanitizers: $(grep -E '^FAILED' "$LOG_DIR/sanitizers.log" | head -10) (log: $LOG_DIR/sanitizers.log)")
-fi
+# run_counted NAME: runs scripts/NAME.sh, whose last line is "NAME: N passed, N failed, N skipped",
+# and adds its counts (one failure if it printed none).
+run_counted() {
+  local name=$1 log=$LOG_DIR/$1.log counts script_passed script_failed script_skipped
+  bash "$REPO/scripts/$name.sh" >"$log" 2>&1 || true
+  counts=$(sed -nE "s/^$name: ([0-9]+) passed, ([0-9]+) failed, ([0-9]+) skipped\$/\\1 \\2 \\3/p" "$log")
+  read -r script_passed script_failed script_skipped <<<"${counts:-0 1 0}"
+  passed=$((passed + script_passed))
+  failed=$((failed + script_failed))
+  skipped=$((skipped + script_skipped))
+  if [ "$script_failed" -gt 0 ]; then
+    failures+=("$name: $(grep -E '^FAILED' "$log" | head -10) (log: $log)")
+  fi
+}
+
+# 3. The linters, on the compile commands of the build above: catkin_lint, shellcheck, clang-tidy.
+run_counted lint
+
+# 4. Sanitizer builds and fuzzing: ASan + UBSan, TSan, libFuzzer.
+run_counted sanitizers
 
 for failure in "${failures[@]}"; do echo "FAILED: $failure"; done
 echo "tests: $passed passed, $failed failed, $skipped skipped"

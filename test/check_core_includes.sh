@@ -9,7 +9,7 @@ source_dir=$2
 status=0
 for source in "$source_dir"/src/core/*.cpp "$source_dir"/include/mvog/*.h; do
   deps=$("$compiler" -x c++ -std=c++17 -M -I"$source_dir/include" -I/usr/include/eigen3 "$source")
-  forbidden=$(tr ' \\' '\n\n' <<<"$deps" | grep -E '/(ros|pcl[^/]*|tf2[^/]*|boost|roscpp|catkin)/' || true)
+  forbidden=$(tr -s '\\ ' '\n' <<<"$deps" | grep -E '/(ros|pcl[^/]*|tf2[^/]*|boost|roscpp|catkin)/' || true)
   if [ -n "$forbidden" ]; then
     echo "FAIL: $source reaches non-core headers:"
     echo "$forbidden" | sort -u | head -20

@@ -4,10 +4,13 @@
 #include <stdexcept>
 #include <string>
 
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <Eigen/Geometry>
 
+#include "mvog/depth_image.h"
 #include "mvog/map.h"
 
 namespace mvog_ros {
@@ -36,6 +39,19 @@ mvog::Scan laserScanToScan(const sensor_msgs::LaserScan& scan,
 /// point_step, data shorter than its dimensions, more than max_points points).
 mvog::Scan pointCloudToScan(const sensor_msgs::PointCloud2& cloud,
                             const Eigen::Isometry3d& map_from_sensor, std::size_t max_points);
+
+/// A depth image with its camera info as an mvog::Scan (mvog::backProjectDepthImage with the
+/// camera info's K: the image rectified, as depth drivers publish it), from the optical frame's
+/// origin. REP-118: encoding "16UC1" (millimetres) or "32FC1" (metres); 0, NaN and -Inf say
+/// nothing (counted in `skipped_pixels`), +Inf is an out-of-range reading.
+/// Throws InvalidMessage for another encoding, big-endian data, a step or data too short for the
+/// image, a camera info of another size than the image or whose K is zero or non-finite, or more
+/// than max_points pixels kept.
+mvog::Scan depthImageToScan(const sensor_msgs::Image& image,
+                            const sensor_msgs::CameraInfo& camera_info,
+                            const Eigen::Isometry3d& map_from_camera,
+                            const mvog::DepthImageConfig& config, std::size_t max_points,
+                            std::size_t& skipped_pixels);
 
 /// Keeps one point per voxel of edge `leaf_size` (the centroid of its points), with PCL.
 /// Non-finite points are dropped: returns how many.

@@ -22,8 +22,10 @@ constexpr double kWarningPeriod = 5.0;
 struct SensorInputsConfig {
   std::vector<std::string> scan_topics;   // LaserScan topics besides `scan`
   std::vector<std::string> cloud_topics;  // PointCloud2 topics besides `cloud_in`
+  std::vector<std::string> depth_topics;  // depth images, each with its sibling `camera_info`
   int sensor_queue_size = 5;              // messages per topic waiting for their transform
   double voxel_filter_size = 0.0;         // m; > 0 downsamples clouds before insertion
+  int depth_stride = 1;                   // every k-th pixel of depth images in both directions
   int max_points_per_message = 2000000;   // larger messages are refused
 
   void validate() const;

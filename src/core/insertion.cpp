@@ -71,7 +71,6 @@ void addedVolumes(const std::vector<ScanInterval>& free, const std::vector<ScanI
 /// One thread's working memory while applying a scan.
 struct ColumnWork {
   ListMerger merger;
-  detail::TileBlock::Builder builder;
   /// The scratches that reached the tile being updated, and their part of it.
   std::vector<std::pair<const detail::ScanScratch*, const detail::ScratchTile*>> parts;
   std::vector<detail::TileHit> hits;                       // the tile's, by cell
@@ -83,16 +82,8 @@ struct ColumnWork {
   CellVolumes merged;
   std::vector<Volume> existing_positive;
   std::vector<Volume> existing_negative;
-  /// The new lists of the tile's cells that the scan reached: volumes[start, start + positive)
-  /// and then its negative ones; and whether each keeps the length of its lists.
-  struct CellResult {
-    unsigned local;
-    std::size_t start;
-    std::uint32_t num_positive;
-    std::uint32_t num_negative;
-  };
-  std::vector<CellResult> results;
-  std::vector<Volume> volumes;
+  /// The new lists of the tile's cells whose lists changed length.
+  detail::TileBlock::Rewrite rewrite;
   CellRange grown = kNoCells;  // cells that received their first volume
 };
 
@@ -209,8 +200,7 @@ void updateTile(detail::TileBlock& tile, std::uint64_t key,
   gatherTile(key, scratches, work);
   // The tile was written before a decay step: bring its masses to the current unit first.
   if (rescale != 1.0) tile.scaleMasses(rescale, exponent);
-  work.results.clear();
-  work.volumes.clear();
+  work.rewrite.clear();
   const CellIndex origin = detail::tileOrigin(key);
   const FreeSpaceRules free_space_rules{rules.split_free_space_at_obstacles,
                                         rules.clip_free_space_at_hits};
@@ -261,11 +251,7 @@ void updateTile(detail::TileBlock& tile, std::uint64_t key,
         std::copy(work.merged.negative.begin(), work.merged.negative.end(), stored + num_positive);
         continue;
       }
-      work.results.push_back({local, work.volumes.size(), num_positive, num_negative});
-      work.volumes.insert(work.volumes.end(), work.merged.positive.begin(),
-                          work.merged.positive.end());
-      work.volumes.insert(work.volumes.end(), work.merged.negative.begin(),
-                          work.merged.negative.end());
+      work.rewrite.set(local, work.merged.positive, work.merged.negative);
       if (existing.empty() && num_positive + num_negative > 0) {
         work.grown.extend(
             CellIndex{origin.x + static_cast<std::int32_t>(local % detail::kTileSize),
@@ -273,28 +259,12 @@ void updateTile(detail::TileBlock& tile, std::uint64_t key,
       }
     }
   }
-  if (work.results.empty()) {
+  if (work.rewrite.empty()) {
     tile.setModifiedRevision(revision);
     return;
   }
   // Some list changed its length: the tile is built anew, its other cells copied.
-  auto result = work.results.begin();
-  unsigned rank = 0;  // of the next cell holding volumes
-  for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
-    const bool held = tile.holds(local);
-    const detail::ColumnRef existing = held ? tile.columnAtRank(rank++) : detail::ColumnRef{};
-    if (result != work.results.end() && result->local == local) {
-      if (result->num_positive + result->num_negative > 0) {
-        const Volume* v = work.volumes.data() + result->start;
-        work.builder.add(
-            local, {v, result->num_positive, v + result->num_positive, result->num_negative}, 1.0);
-      }
-      ++result;
-    } else if (held) {
-      work.builder.add(local, existing, 1.0);
-    }
-  }
-  tile = work.builder.finish(exponent, revision);
+  tile = work.rewrite.apply(tile, exponent, revision);
 }
 
 }  // namespace

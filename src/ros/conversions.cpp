@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
 
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/point_cloud.h>
@@ -117,6 +118,53 @@ mvog::Scan pointCloudToScan(const sensor_msgs::PointCloud2& cloud,
     }
   }
   return readings;
+}
+
+mvog::Scan depthImageToScan(const sensor_msgs::Image& image,
+                            const sensor_msgs::CameraInfo& camera_info,
+                            const Eigen::Isometry3d& map_from_camera,
+                            const mvog::DepthImageConfig& config, std::size_t max_points,
+                            std::size_t& skipped_pixels) {
+  mvog::DepthImageView view;
+  if (image.encoding == "16UC1") {
+    view.encoding = mvog::DepthEncoding::kUint16Millimetres;
+  } else if (image.encoding == "32FC1") {
+    view.encoding = mvog::DepthEncoding::kFloat32Metres;
+  } else {
+    throw InvalidMessage("depth image encoding '" + image.encoding +
+                         "' is neither 16UC1 (millimetres) nor 32FC1 (metres)");
+  }
+  if (static_cast<bool>(image.is_bigendian) != kHostIsBigEndian) {
+    throw InvalidMessage("depth image is big-endian (is_bigendian set): not supported");
+  }
+  if (camera_info.width != image.width || camera_info.height != image.height) {
+    throw InvalidMessage("camera info is for " + std::to_string(camera_info.width) + "x" +
+                         std::to_string(camera_info.height) + " pixels, the depth image has " +
+                         std::to_string(image.width) + "x" + std::to_string(image.height));
+  }
+  view.data = image.data.data();
+  view.size = image.data.size();
+  view.width = image.width;
+  view.height = image.height;
+  view.step = image.step;
+  const mvog::PinholeCamera camera{camera_info.K[0], camera_info.K[4], camera_info.K[2],
+                                   camera_info.K[5]};
+  try {
+    view.validate();
+  } catch (const mvog::ConfigError& e) {
+    throw InvalidMessage(std::string("depth image ") + e.what());
+  }
+  try {
+    camera.validate();
+  } catch (const mvog::ConfigError& e) {
+    throw InvalidMessage(std::string("camera info K: ") + e.what());
+  }
+  const std::size_t pixels = mvog::keptPixels(view, config);
+  if (pixels > max_points) {
+    throw InvalidMessage("depth image keeps " + std::to_string(pixels) +
+                         " pixels, more than ~max_points_per_message");
+  }
+  return mvog::backProjectDepthImage(view, camera, map_from_camera, config, skipped_pixels);
 }
 
 std::size_t voxelFilter(std::vector<Eigen::Vector3f>& points, double leaf_size) {

@@ -1,5 +1,6 @@
 #include "mvog_ros/mapper.h"
 
+#include <algorithm>
 #include <mutex>
 #include <utility>
 
@@ -25,10 +26,15 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
       window_(private_nh, config_.lifetime, config_.frame_id, config_.map_files.map_directory,
               config_.publications.publish_period, map_, tf_buffer_,
               [this] { return insertion_.latestOrigin(); }),
-      inputs_(nh, config_.inputs, config_.frame_id, config_.insertion.max_range, tf_buffer_,
-              [this](mvog::Scan&& scan, const std::string& source) {
-                insertion_.enqueue(std::move(scan), source);
-              }),
+      // A depth image's +Inf pixels (no return) free their ray as far as the core would free any
+      // out-of-range reading: ~max_range, or the map's out_of_range_free_length if shorter.
+      inputs_(
+          nh, config_.inputs, config_.frame_id, config_.insertion.max_range,
+          std::min(config_.insertion.max_range, map_.map.config().rules.out_of_range_free_length),
+          tf_buffer_,
+          [this](mvog::Scan&& scan, const std::string& source) {
+            insertion_.enqueue(std::move(scan), source);
+          }),
       reset_(
           private_nh, map_, [this](mvog::Map&& map) { replaceMap(std::move(map)); },
           [this] {
@@ -40,9 +46,9 @@ Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
     decay_timer_ =
         private_nh.createTimer(ros::Duration(config_.decay.decay_period), &Mapper::decay, this);
   }
-  ROS_INFO("mvog: mapping in '%s' at %.3f m, %zu scan and %zu cloud topics",
+  ROS_INFO("mvog: mapping in '%s' at %.3f m, %zu scan, %zu cloud and %zu depth image topics",
            config_.frame_id.c_str(), map_.map.resolution(), config_.inputs.scan_topics.size() + 1,
-           config_.inputs.cloud_topics.size() + 1);
+           config_.inputs.cloud_topics.size() + 1, config_.inputs.depth_topics.size());
 }
 
 Mapper::~Mapper() {

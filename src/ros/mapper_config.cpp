@@ -150,10 +150,12 @@ void readModel(const ros::NodeHandle& nh, MapperConfig& config) {
 void SensorInputsConfig::validate() const {
   requireTopics(scan_topics, "scan_topics");
   requireTopics(cloud_topics, "cloud_topics");
+  requireTopics(depth_topics, "depth_topics");
   require(sensor_queue_size >= 1 && sensor_queue_size <= 1000, "sensor_queue_size",
           "must be in [1, 1000]");
   require(std::isfinite(voxel_filter_size) && voxel_filter_size >= 0.0, "voxel_filter_size",
           "must be a finite number >= 0 (0: off)");
+  require(depth_stride >= 1, "depth_stride", "must be >= 1");
   require(max_points_per_message >= 1, "max_points_per_message", "must be >= 1");
 }
 
@@ -239,8 +241,10 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   SensorInputsConfig& inputs = config.inputs;
   read(nh, "scan_topics", inputs.scan_topics);
   read(nh, "cloud_topics", inputs.cloud_topics);
+  read(nh, "depth_topics", inputs.depth_topics);
   read(nh, "sensor_queue_size", inputs.sensor_queue_size);
   read(nh, "voxel_filter_size", inputs.voxel_filter_size);
+  read(nh, "depth_stride", inputs.depth_stride);
   read(nh, "max_points_per_message", inputs.max_points_per_message);
 
   InsertionWorkerConfig& insertion = config.insertion;

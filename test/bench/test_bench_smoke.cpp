@@ -1,7 +1,7 @@
 // Smoke test of mvog_bench: behaviour only (never timings). Runs the executable on
 // spherical_scan.graph from the shared data (MVOG_DATA_DIR, default ../shared/data beside the
-// repository; skipped when absent unless CI=true), on scan graphs it writes itself, and on bad
-// input.
+// repository; skipped when absent unless CI=true), on scan graphs and a bag of depth images it
+// writes itself, and on bad input.
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <string>
@@ -17,6 +18,10 @@
 
 #include <gtest/gtest.h>
 #include <json/json.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "../recordings.h"
 
@@ -129,6 +134,72 @@ TEST_F(BenchSmokeTest, ReadsEveryNodeOfAGraphItWrote) {
   }
   EXPECT_EQ(root["input"]["scans"].asUInt64(), 2u);
   EXPECT_EQ(root["repeat"].asInt(), 2);
+}
+
+/// A depth image of `width` x `height` pixels of `encoding` (Pixel: std::uint16_t for 16UC1,
+/// float for 32FC1), every pixel `depth`, at `seconds`.
+template <class Pixel>
+sensor_msgs::Image depthImage(const std::string& encoding, std::uint32_t width,
+                              std::uint32_t height, Pixel depth, double seconds) {
+  sensor_msgs::Image image;
+  image.header.frame_id = "camera";
+  image.header.stamp = ros::Time(seconds);
+  image.width = width;
+  image.height = height;
+  image.encoding = encoding;
+  image.step = width * static_cast<std::uint32_t>(sizeof(Pixel));
+  const std::vector<Pixel> pixels(std::size_t{width} * height, depth);
+  image.data.resize(pixels.size() * sizeof(Pixel));
+  std::memcpy(image.data.data(), pixels.data(), image.data.size());
+  return image;
+}
+
+sensor_msgs::CameraInfo cameraInfoOf(const sensor_msgs::Image& image) {
+  sensor_msgs::CameraInfo info;
+  info.header = image.header;
+  info.width = image.width;
+  info.height = image.height;
+  info.K = {4.0, 0.0, 1.5, 0.0, 4.0, 1.0, 0.0, 0.0, 1.0};
+  return info;
+}
+
+TEST_F(BenchSmokeTest, ReadsTheDepthImagesOfABagWithTheCameraInfoOfTheirStamp) {
+  const std::string input = directory_ + "/depth.bag";
+  {
+    rosbag::Bag bag(input, rosbag::bagmode::Write);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.resize(1);
+    tf.transforms[0].header.frame_id = "map";
+    tf.transforms[0].header.stamp = ros::Time(1.0);
+    tf.transforms[0].child_frame_id = "camera";
+    tf.transforms[0].transform.translation.z = 1.0;
+    tf.transforms[0].transform.rotation.w = 1.0;
+    bag.write("/tf_static", ros::Time(1.0), tf);
+    const std::string image_topic = "/camera/depth/image";
+    const std::string info_topic = "/camera/depth/camera_info";
+    const sensor_msgs::Image millimetres = depthImage<std::uint16_t>("16UC1", 4, 3, 2000, 2.0);
+    bag.write(info_topic, ros::Time(2.0), cameraInfoOf(millimetres));
+    bag.write(image_topic, ros::Time(2.0), millimetres);
+    // Not range data: not read.
+    bag.write("/camera/rgb/image", ros::Time(2.5), depthImage<float>("rgb8", 4, 3, 1.0f, 2.5));
+    // Without the camera info of its stamp: skipped.
+    bag.write(image_topic, ros::Time(3.0), depthImage<std::uint16_t>("16UC1", 4, 3, 1000, 3.0));
+    sensor_msgs::Image metres = depthImage<float>("32FC1", 4, 3, 1.5f, 4.0);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::memcpy(metres.data.data() + 4 * 5, &nan, 4);  // one pixel says nothing
+    bag.write(image_topic, ros::Time(4.0), metres);    // its camera info comes after it
+    bag.write(info_topic, ros::Time(4.1), cameraInfoOf(metres));
+  }
+  const std::string json = directory_ + "/depth.json";
+  std::string errors;
+  ASSERT_EQ(runBench("--input '" + input + "' --backend mvog --json '" + json + "'", errors), 0)
+      << errors;
+  const Json::Value root = readJson(json);
+  EXPECT_EQ(root["input"]["sensor_messages"].asUInt64(), 3u);
+  EXPECT_EQ(root["input"]["messages_without_camera_info"].asUInt64(), 1u);
+  EXPECT_EQ(root["input"]["scans"].asUInt64(), 2u);
+  EXPECT_EQ(root["input"]["readings"].asUInt64(), 12u + 11u);
+  EXPECT_EQ(root["input"]["invalid_pixels"].asUInt64(), 1u);
 }
 
 TEST_F(BenchSmokeTest, RefusesBadInputWithAMessage) {

@@ -1,14 +1,15 @@
 // libFuzzer target: the message conversions of the ROS layer (mvog_ros/conversions.h) on
-// LaserScan and PointCloud2 messages built from arbitrary bytes, then insertion of what they
-// yield into a map.
+// LaserScan, PointCloud2 and depth Image (with CameraInfo) messages built from arbitrary bytes,
+// then insertion of what they yield into a map.
 //
-// Whatever the message, laserScanToScan / pointCloudToScan return a Scan or throw
-// InvalidMessage: no crash, no undefined behaviour, no allocation beyond what the message holds.
+// Whatever the message, laserScanToScan / pointCloudToScan / depthImageToScan return a Scan or
+// throw InvalidMessage: no crash, no undefined behaviour, no allocation beyond what the message
+// holds.
 // Readings that come out go into an mvog::Map, which must count every one of them exactly once.
 //
 // Input layout (little-endian, read from the front; missing bytes read as zero), also written by
 // test/fuzz/make_seeds.py:
-//   u8  kind            bit 0: 0 LaserScan, 1 PointCloud2
+//   u8  kind            bits 0-1: 0 LaserScan, 1 PointCloud2, 2 or 3 depth image
 //   u8  options         bit 0: insert the readings into a map, bit 1: the paper's model (else the
 //                       default rules),
 //                       bit 2: no negative space, bit 3: two insertion threads
@@ -19,6 +20,10 @@
 //   PointCloud2: u8 is_bigendian, u32 height, width, point_step, row_step, u8 fields (at most 8),
 //                each: u8 name (x y z rgb intensity xx), u32 offset, u8 datatype, u32 count;
 //                the rest is the data
+//   depth image: u8 encoding (16UC1 32FC1 mono16 32FC2 rgb8), u8 is_bigendian, u32 width,
+//                height, step, camera info u32 width, height, f64 fx, fy, cx, cy, u8 stride
+//                (1 + its value % 8), f32 no_return_length (not > 0: infinite); the rest is the
+//                data
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -113,6 +118,37 @@ sensor_msgs::LaserScan takeScan(Input& in, double& max_free_range) {
   return scan;
 }
 
+struct DepthImageMessage {
+  sensor_msgs::Image image;
+  sensor_msgs::CameraInfo camera_info;
+  mvog::DepthImageConfig config;
+};
+
+DepthImageMessage takeDepthImage(Input& in) {
+  static const char* const kEncodings[] = {"16UC1", "32FC1", "mono16", "32FC2", "rgb8"};
+  DepthImageMessage message;
+  sensor_msgs::Image& image = message.image;
+  image.header.frame_id = "camera";
+  image.encoding = kEncodings[in.take<std::uint8_t>() % 5];
+  image.is_bigendian = in.take<std::uint8_t>() & 1;
+  image.width = in.take<std::uint32_t>();
+  image.height = in.take<std::uint32_t>();
+  image.step = in.take<std::uint32_t>();
+  sensor_msgs::CameraInfo& info = message.camera_info;
+  info.width = in.take<std::uint32_t>();
+  info.height = in.take<std::uint32_t>();
+  info.K[0] = in.take<double>();
+  info.K[4] = in.take<double>();
+  info.K[2] = in.take<double>();
+  info.K[5] = in.take<double>();
+  info.K[8] = 1.0;
+  message.config.stride = 1 + in.take<std::uint8_t>() % 8;
+  const float no_return_length = in.take<float>();  // validated by the server: > 0 or infinite
+  if (no_return_length > 0.0f) message.config.no_return_length = no_return_length;
+  image.data = in.rest();
+  return message;
+}
+
 sensor_msgs::PointCloud2 takeCloud(Input& in) {
   static const char* const kNames[] = {"x", "y", "z", "rgb", "intensity", "xx"};
   sensor_msgs::PointCloud2 cloud;
@@ -139,14 +175,27 @@ sensor_msgs::PointCloud2 takeCloud(Input& in) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   Input in(data, size);
-  const bool is_cloud = in.take<std::uint8_t>() & 1;
+  const unsigned kind = in.take<std::uint8_t>() & 3;
   const std::uint8_t options = in.take<std::uint8_t>();
   const Eigen::Isometry3d pose = takePose(in);
   mvog::Scan readings;
   std::size_t skipped = 0;
   std::size_t message_points = 0;
   try {
-    if (is_cloud) {
+    if (kind >= 2) {
+      const DepthImageMessage message = takeDepthImage(in);
+      readings = mvog_ros::depthImageToScan(message.image, message.camera_info, pose,
+                                            message.config, kMaxPoints, skipped);
+      // Refused unless every kept pixel lies within the data.
+      const std::size_t pixel_bytes = message.image.encoding == "16UC1" ? 2 : 4;
+      check(std::uint64_t{message.image.step} * message.image.height <= message.image.data.size());
+      check(std::uint64_t{message.image.width} * pixel_bytes <= message.image.step);
+      // Every kept pixel counted once: a reading, or skipped.
+      const std::size_t stride = static_cast<std::size_t>(message.config.stride);
+      message_points = ((message.image.width + stride - 1) / stride) *
+                       ((message.image.height + stride - 1) / stride);
+      check(readings.hits.size() + readings.out_of_range.size() + skipped == message_points);
+    } else if (kind == 1) {
       const sensor_msgs::PointCloud2 cloud = takeCloud(in);
       readings = mvog_ros::pointCloudToScan(cloud, pose, kMaxPoints);
       message_points = std::size_t{cloud.width} * cloud.height;

@@ -101,6 +101,30 @@ def cloud(points, fields, point_step, width, row_padding=0, big_endian=False, op
 
 
 XYZ32 = [('x', 0, FLOAT32), ('y', 4, FLOAT32), ('z', 8, FLOAT32)]
+ENCODINGS = {'16UC1': 0, '32FC1': 1, 'mono16': 2, '32FC2': 3, 'rgb8': 4}
+
+
+def depth_image(depths, width, encoding='32FC1', big_endian=False, step=None, info_size=None,
+                k=(40.0, 40.0, None, None), stride=1, no_return_length=0.0, options=1, data=None):
+    """depths: row after row, metres (millimetres for 16UC1); k: fx, fy, cx, cy (None: centre)."""
+    height = len(depths) // width if width else 0
+    pixel = 2 if encoding == '16UC1' else 4
+    step = width * pixel if step is None else step
+    info_width, info_height = (width, height) if info_size is None else info_size
+    fx, fy, cx, cy = k
+    cx = (width - 1) / 2.0 if cx is None else cx
+    cy = (height - 1) / 2.0 if cy is None else cy
+    out = struct.pack('<BB', 2, options) + pose(0.0, 0.0, 1.5, -math.pi / 2, 0.0, -math.pi / 2)
+    out += struct.pack('<BBIIIII4dBf', ENCODINGS[encoding], 1 if big_endian else 0, width,
+                       height, step, info_width, info_height, fx, fy, cx, cy, stride - 1,
+                       no_return_length)
+    if data is None:
+        body = bytearray(b'\xab' * (step * height))
+        code = ('>' if big_endian else '<') + ('H' if pixel == 2 else 'f')
+        for n, depth in enumerate(depths):
+            struct.pack_into(code, body, (n // width) * step + (n % width) * pixel, depth)
+        data = bytes(body)
+    return out + data
 
 
 def main():
@@ -174,6 +198,21 @@ def main():
         'cloud_short_data': cloud([], XYZ32, 12, 100, height=100, data=b'\0' * 120),
         'cloud_absurd_size': cloud([], XYZ32, 12, 0xFFFFFFFF, height=0xFFFFFFFF, data=b''),
         'cloud_empty': cloud([], XYZ32, 12, 0, height=0, data=b''),
+        'depth_millimetres': depth_image([1500, 0, 2000, 2500, 3000, 0, 1200, 900, 4000], 3,
+                                         encoding='16UC1'),
+        'depth_metres_special_values': depth_image(
+            [2.0, 0.0, NAN, INF, -INF, -1.0, 3.5, 1e30], 4, no_return_length=5.0,
+            options=1 | 2),
+        'depth_metres_padded_stride': depth_image([1.0 + 0.1 * n for n in range(20)], 5,
+                                                  step=27, stride=2, options=1 | 8),
+        'depth_no_return_without_length': depth_image([INF] * 6, 3),
+        'depth_wrong_encoding': depth_image([1.0] * 4, 2, encoding='rgb8'),
+        'depth_big_endian': depth_image([1000] * 4, 2, encoding='16UC1', big_endian=True),
+        'depth_step_too_small': depth_image([1.0] * 4, 2, step=7, data=b'\0' * 14),
+        'depth_data_short': depth_image([1.0] * 4, 2, data=b'\0' * 15),
+        'depth_zero_k': depth_image([1.0] * 4, 2, k=(0.0, 0.0, 0.0, 0.0)),
+        'depth_nan_k': depth_image([1.0] * 4, 2, k=(NAN, 40.0, 0.5, 0.5)),
+        'depth_camera_info_other_size': depth_image([1.0] * 4, 2, info_size=(4, 4)),
     }
     for name, data in inputs.items():
         with open(os.path.join(HERE, 'corpus', 'conversions', name), 'wb') as f:

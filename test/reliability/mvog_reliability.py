@@ -17,7 +17,7 @@ import time
 import rospy
 import tf2_ros
 from geometry_msgs.msg import TransformStamped
-from sensor_msgs.msg import LaserScan, PointCloud2, PointField
+from sensor_msgs.msg import CameraInfo, Image, LaserScan, PointCloud2, PointField
 
 from mvog.msg import MapStatistics
 from mvog.srv import GetOccupancy, MapFile
@@ -115,6 +115,42 @@ def cloud(points, fields=XYZ32, point_step=12, width=None, height=1, big_endian=
     return message
 
 
+def depth_image(depths, width, encoding="32FC1", big_endian=False, step=None, data=None,
+                frame="camera", stamp=None):
+    """A depth image of `depths` (row after row; millimetres for 16UC1, else metres), its rows
+    `step` bytes apart (default: packed); `data` overrides the pixels."""
+    message = Image()
+    message.header.frame_id = frame
+    message.header.stamp = stamp if stamp is not None else rospy.Time.now()
+    message.width = width
+    message.height = len(depths) // width if width else 0
+    message.encoding = encoding
+    message.is_bigendian = big_endian
+    pixel = 2 if encoding in ("16UC1", "mono16") else 4
+    message.step = width * pixel if step is None else step
+    if data is None:
+        body = bytearray(b"\0" * (message.step * message.height))
+        code = (">" if big_endian else "<") + ("H" if pixel == 2 else "f")
+        for k, depth in enumerate(depths):
+            struct.pack_into(code, body, (k // width) * message.step + (k % width) * pixel, depth)
+        data = bytes(body)
+    message.data = data
+    return message
+
+
+def camera_info(image, fx=4.0, fy=4.0, cx=None, cy=None, width=None, height=None):
+    """The camera info of `image` (same header): K of the focal lengths and principal point
+    given (default: the image's centre), for an image of `width` x `height` (default: its own)."""
+    message = CameraInfo()
+    message.header = image.header
+    message.width = image.width if width is None else width
+    message.height = image.height if height is None else height
+    cx = (image.width - 1) / 2.0 if cx is None else cx
+    cy = (image.height - 1) / 2.0 if cy is None else cy
+    message.K = [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]
+    return message
+
+
 def fnv1a64(data):
     h = 0xcbf29ce484222325
     for b in data:
@@ -123,7 +159,8 @@ def fnv1a64(data):
 
 
 class Server:
-    """One mvog_node started by the test: /NAME, reading /NAME/scan_in and /NAME/cloud_in."""
+    """One mvog_node started by the test: /NAME, reading /NAME/scan_in, /NAME/cloud_in and the
+    depth images of /NAME/depth/image with /NAME/depth/camera_info."""
 
     DEFAULTS = {"resolution": 0.1, "statistics_period": 0.1, "publish_period": 0.5,
                 "binary_map_period": 0.0}
@@ -133,7 +170,8 @@ class Server:
         self.ns = "/" + name
         self.own_directory = directory is None
         self.directory = directory or tempfile.mkdtemp(prefix="mvog_reliability_")
-        self.params = dict(self.DEFAULTS, map_directory=self.directory, **(params or {}))
+        self.params = dict(self.DEFAULTS, map_directory=self.directory,
+                           depth_topics=[self.ns + "/depth/image"], **(params or {}))
         log_fd, self.log_path = tempfile.mkstemp(prefix="mvog_reliability_%s_" % name,
                                                  suffix=".log")
         self.log = os.fdopen(log_fd, "w")
@@ -146,6 +184,9 @@ class Server:
                                                       self._on_statistics)
         self.scans = rospy.Publisher(self.ns + "/scan_in", LaserScan, queue_size=1000)
         self.clouds = rospy.Publisher(self.ns + "/cloud_in", PointCloud2, queue_size=1000)
+        self.depth_images = rospy.Publisher(self.ns + "/depth/image", Image, queue_size=1000)
+        self.camera_infos = rospy.Publisher(self.ns + "/depth/camera_info", CameraInfo,
+                                            queue_size=1000)
         self.process = subprocess.Popen(
             ["rosrun", "mvog", "mvog_node", "__name:=" + name, "scan:=" + self.ns + "/scan_in",
              "cloud_in:=" + self.ns + "/cloud_in"],
@@ -156,12 +197,13 @@ class Server:
         self.statistics = message
 
     def wait_ready(self):
-        """Services up, statistics flowing, and both sensor topics connected."""
+        """Services up, statistics flowing, and every sensor topic connected."""
         wait_for(lambda: self.process.poll() is None and self.statistics is not None,
                  "%s to publish statistics (log: %s)" % (self.name, self.log_path))
         rospy.wait_for_service(self.ns + "/save_map", timeout=TIMEOUT)
-        wait_for(lambda: self.scans.get_num_connections() > 0 and
-                 self.clouds.get_num_connections() > 0, "%s to subscribe" % self.name)
+        wait_for(lambda: all(publisher.get_num_connections() > 0 for publisher in
+                             (self.scans, self.clouds, self.depth_images, self.camera_infos)),
+                 "%s to subscribe" % self.name)
         return self
 
     def wait_exit(self):
@@ -219,8 +261,8 @@ class Server:
 
     def stop(self):
         self.statistics_subscriber.unregister()
-        self.scans.unregister()
-        self.clouds.unregister()
+        for publisher in (self.scans, self.clouds, self.depth_images, self.camera_infos):
+            publisher.unregister()
         if self.process.poll() is None:
             self.process.send_signal(signal.SIGINT)
             try:
@@ -247,4 +289,4 @@ def rss_kb(pid):
 
 
 __all__ = ["Server", "wait_for", "wait_for_or_not", "transform", "init_test_node", "scan", "cloud",
-           "fnv1a64", "rss_kb", "FLOAT32", "FLOAT64", "INT32", "XYZ32", "TIMEOUT"]
+           "depth_image", "camera_info", "fnv1a64", "rss_kb", "FLOAT32", "FLOAT64", "INT32", "XYZ32", "TIMEOUT"]

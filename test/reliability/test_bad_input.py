@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Bad input to a running mapping server (see bad_input.test and RELIABILITY.md).
 
-Every malformed LaserScan, PointCloud2, frame, stamp, service request, path, map file and
+Every malformed LaserScan, PointCloud2, depth image, frame, stamp, service request, path, map file and
 parameter of the issue is sent to a real mvog_node. Each must be counted in ~statistics (or
 answered with a message), leave the map byte for byte as it was (a save before and after), and
 leave the server running and mapping; a bad parameter must stop the server at start, naming it.
@@ -82,6 +82,8 @@ class BadInput(unittest.TestCase):
         self.assertTrue(self.server.alive(), what)
         outcome = {"messages_dropped_invalid": "refused, counted in messages_dropped_invalid",
                    "messages_dropped_tf": "dropped, counted in messages_dropped_tf",
+                   "messages_dropped_camera_info":
+                   "dropped, counted in messages_dropped_camera_info",
                    "messages_inserted": "taken"}[counter]
         if rejected_readings is not None:
             outcome += ("; %d readings counted in readings_rejected" % rejected_readings)
@@ -212,6 +214,80 @@ class BadInput(unittest.TestCase):
         response = self.server.occupancy([(2.55, 2.55, 1.0)])
         self.assertEqual(response.state[0], 2, "the big-endian point was not mapped")
         record("PointCloud2 is_bigendian set (big-endian data)", "mapped, bytes swapped")
+
+    # ---- Depth images ---------------------------------------------------------------------
+
+    def publish_depth(self, image, info=None):
+        """The camera info first (the server pairs them in either order), then the image."""
+        self.server.camera_infos.publish(rel.camera_info(image) if info is None else info)
+        self.server.depth_images.publish(image)
+
+    def test_depth_image(self):
+        # 8 x 6 pixels looking up from the camera frame (1 m high), 2 m away.
+        good = rel.depth_image([2000] * 48, 8, encoding="16UC1")
+        short = bytes(good.data[:-1])
+        k_nan = rel.camera_info(good, fx=NAN)
+        k_zero = rel.camera_info(good, fx=0.0, fy=0.0, cx=0.0, cy=0.0)
+        invalid = [
+            ("encoding rgb8", rel.depth_image([1] * 48, 8, encoding="rgb8"), None),
+            ("encoding mono16", rel.depth_image([2000] * 48, 8, encoding="mono16"), None),
+            ("big-endian 16-bit", rel.depth_image([2000] * 48, 8, encoding="16UC1",
+                                                  big_endian=True), None),
+            ("step smaller than width*bytes", rel.depth_image([2000] * 48, 8, encoding="16UC1",
+                                                              step=15, data=good.data), None),
+            ("data shorter than height*step", rel.depth_image([2000] * 48, 8, encoding="16UC1",
+                                                              data=short), None),
+            ("K zero", good, k_zero),
+            ("K NaN", good, k_nan),
+            ("camera info of another size", good, rel.camera_info(good, width=640, height=480)),
+        ]
+        for what, image, info in invalid:
+            image.header.stamp = rospy.Time.now()
+            if info is not None:
+                info.header = image.header
+            self.expect("depth image " + what, lambda: self.publish_depth(image, info),
+                        "messages_dropped_invalid")
+        self.assertTrue(any("encoding 'rgb8'" in line for line in self.server.output().splitlines()
+                            if "dropped an invalid depth image" in line), "no warning naming it")
+
+        def publish_without_camera_info():
+            # Images wait for the camera info of their stamp; beyond ~sensor_queue_size waiting,
+            # the oldest is dropped and counted.
+            before = self.server.stats().messages_dropped_camera_info
+            for _ in range(100):
+                self.server.depth_images.publish(rel.depth_image([2000] * 48, 8, encoding="16UC1"))
+                if rel.wait_for_or_not(lambda: self.server.statistics.messages_dropped_camera_info
+                                       > before, 0.5):
+                    return
+        self.expect("depth image without camera info, several", publish_without_camera_info,
+                    "messages_dropped_camera_info")
+        OUTCOMES[-1] = (OUTCOMES[-1][0], "waits for its camera info; beyond ~sensor_queue_size "
+                        "waiting, the oldest is dropped and counted in "
+                        "messages_dropped_camera_info; map unchanged")
+
+        # REP-118: 0, NaN and -Inf say nothing.
+        for what, depths in [("0 pixels (16UC1)", [0] * 12), ("NaN pixels", [NAN] * 12),
+                             ("-Inf pixels", [-INF] * 12)]:
+            encoding = "16UC1" if "16UC1" in what else "32FC1"
+            self.expect("depth image of " + what,
+                        lambda: self.publish_depth(rel.depth_image(depths, 4, encoding=encoding)),
+                        "messages_inserted", rejected_readings=len(depths))
+        # +Inf: no return, free space only (from the laser frame, 0.5 m high: below the good
+        # image's surface, which it must not touch).
+        before = self.server.stats()
+        self.publish_depth(rel.depth_image([INF] * 12, 4, frame="laser"))
+        after = self.server.wait_counter("messages_inserted", before.messages_inserted + 1)
+        self.assertEqual(after.out_of_range_readings - before.out_of_range_readings, 12)
+        self.assertEqual(after.positive_volumes, before.positive_volumes)
+        record("depth image of +Inf pixels", "free space up to ~max_range (REP-118, "
+               "~out_of_range_free_length), no obstacle")
+        # A good image maps: the pixel (4, 3) sees (0.25 m, 0.25 m) 2 m above the camera.
+        before = self.server.stats()
+        self.publish_depth(good)
+        self.server.wait_counter("messages_inserted", before.messages_inserted + 1)
+        response = self.server.occupancy([(0.25, 0.25, rel.CAMERA_HEIGHT + 2.0)])
+        self.assertEqual(response.state[0], 2, "the depth image was not mapped")
+        record("depth image 16UC1 with its camera info", "mapped")
 
     # ---- Frames and stamps ----------------------------------------------------------------
 
@@ -353,6 +429,7 @@ class BadInput(unittest.TestCase):
                  ("occupancy_threshold", {"occupancy_threshold": NAN}),
                  ("projection_min_z", {"projection_min_z": 2.0, "projection_max_z": 1.0}),
                  ("max_query_points", {"max_query_points": 0}),
+                 ("depth_stride", {"depth_stride": 0}),
                  ("autosave_period", {"autosave_period": -5.0})]
         for k, (parameter, values) in enumerate(cases):
             server = rel.Server("mapper_refused_%d" % k, values)

@@ -56,6 +56,8 @@ TEST(MapperConfig, AcceptsSensibleNonDefaultValues) {
   config.insertion.insertion_threads = 4;
   config.inputs.scan_topics = {"front/scan", "/rear/scan", "~scan"};
   config.inputs.cloud_topics = {"camera/depth/points"};
+  config.inputs.depth_topics = {"camera/depth/image_rect_raw", "/tof/depth"};
+  config.inputs.depth_stride = 4;
   config.queries.tf_timeout = 0.0;
   config.inputs.voxel_filter_size = 0.05;
   config.decay.decay_factor = 0.9;
@@ -147,6 +149,8 @@ TEST(MapperConfig, RefusesOutOfRangeValues) {
       {"insertion_queue_size", "huge",
        [](MapperConfig& c) { c.insertion.insertion_queue_size = 1 << 30; }},
       {"max_points_per_message", "0", [](MapperConfig& c) { c.inputs.max_points_per_message = 0; }},
+      {"depth_stride", "0", [](MapperConfig& c) { c.inputs.depth_stride = 0; }},
+      {"depth_stride", "< 0", [](MapperConfig& c) { c.inputs.depth_stride = -2; }},
       {"max_points_per_message", "< 0",
        [](MapperConfig& c) { c.inputs.max_points_per_message = -1; }},
       {"decay_factor", "> 1", [](MapperConfig& c) { c.decay.decay_factor = 1.5; }},
@@ -229,6 +233,9 @@ TEST(MapperConfig, RefusesEmptyOrInvalidNames) {
       {"cloud_topics", "an empty topic", [](MapperConfig& c) { c.inputs.cloud_topics = {""}; }},
       {"cloud_topics", "an invalid topic",
        [](MapperConfig& c) { c.inputs.cloud_topics = {"3d/pts"}; }},
+      {"depth_topics", "an empty topic", [](MapperConfig& c) { c.inputs.depth_topics = {""}; }},
+      {"depth_topics", "an invalid topic",
+       [](MapperConfig& c) { c.inputs.depth_topics = {"depth image"}; }},
   };
   for (const InvalidCase& invalid : cases) expectRefused(invalid);
 }

@@ -17,7 +17,8 @@ import tf2_ros
 from tf2_msgs.msg import TFMessage
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "make_scene.py"
-CAMERA_TOPIC, SCAN_TOPIC = "/camera/depth/points", "/scan"
+CAMERA_TOPIC, CAMERA_INFO_TOPIC, SCAN_TOPIC = (
+    "/camera/depth/image", "/camera/depth/camera_info", "/scan")
 
 
 def make_scene(directory, *args):
@@ -60,6 +61,8 @@ class MakeSceneTest(unittest.TestCase):
                     cls.buffer.set_transform_static(transform, "bag")
                 else:
                     cls.buffer.set_transform(transform, "bag")
+        cls.camera_infos = {msg.header.stamp: msg for _, msg, _ in
+                            cls.bag.read_messages(topics=[CAMERA_INFO_TOPIC])}
 
     @classmethod
     def tearDownClass(cls):
@@ -73,7 +76,10 @@ class MakeSceneTest(unittest.TestCase):
         topics = self.bag.get_type_and_topic_info().topics
         self.assertEqual(topics["/tf_static"].message_count, 1)
         self.assertEqual(topics["/tf"].msg_type, "tf2_msgs/TFMessage")
-        self.assertEqual(topics[CAMERA_TOPIC].msg_type, "sensor_msgs/PointCloud2")
+        self.assertEqual(topics[CAMERA_TOPIC].msg_type, "sensor_msgs/Image")
+        self.assertEqual(topics[CAMERA_INFO_TOPIC].msg_type, "sensor_msgs/CameraInfo")
+        self.assertEqual(topics[CAMERA_INFO_TOPIC].message_count,
+                         topics[CAMERA_TOPIC].message_count)
         self.assertEqual(topics[SCAN_TOPIC].msg_type, "sensor_msgs/LaserScan")
         self.assertGreater(topics[CAMERA_TOPIC].message_count, 50)
         self.assertGreater(topics[SCAN_TOPIC].message_count, 500)
@@ -94,8 +100,17 @@ class MakeSceneTest(unittest.TestCase):
         obstacles = self.truth["static_boxes"] + [self.truth["person"]["swept_box"]]
         for topic, msg, _ in self.sensor_messages():
             if topic == CAMERA_TOPIC:
-                self.assertEqual((msg.width, msg.height, msg.point_step), (88, 72, 12))
-                local = np.frombuffer(msg.data, "<f4").reshape(-1, 3).astype(float)
+                # Back-projected with the camera info of its stamp (REP-118: +Inf, no return).
+                self.assertEqual((msg.width, msg.height, msg.encoding, msg.step),
+                                 (88, 72, "32FC1", 4 * 88))
+                info = self.camera_infos[msg.header.stamp]
+                self.assertEqual((info.width, info.height), (msg.width, msg.height))
+                depth = np.frombuffer(msg.data, "<f4").astype(float)
+                self.assertFalse(np.isnan(depth).any())
+                u, v = np.meshgrid(np.arange(msg.width), np.arange(msg.height))
+                fx, cx, fy, cy = info.K[0], info.K[2], info.K[4], info.K[5]
+                local = np.stack([(u.ravel() - cx) / fx * depth, (v.ravel() - cy) / fy * depth,
+                                  depth], axis=1)
             else:
                 ranges = np.array(msg.ranges)
                 self.assertFalse(np.isnan(ranges).any())

@@ -9,13 +9,15 @@
 namespace mvog_ros {
 
 /// The server's sensor inputs: a LaserScanInput for `scan` and each of ~scan_topics, a
-/// PointCloudInput for `cloud_in` and each of ~cloud_topics (topics relative to `nh`), and the
-/// counts of what they dropped.
+/// PointCloudInput for `cloud_in` and each of ~cloud_topics, a DepthImageInput for each of
+/// ~depth_topics (topics relative to `nh`), and the counts of what they dropped.
 class SensorInputs {
  public:
-  /// `max_range`: ~max_range, where LaserScan out-of-range readings end at the latest.
+  /// `max_range`: ~max_range, where LaserScan out-of-range readings end at the latest;
+  /// `depth_no_return_length`: where those of depth images end (DepthImageConfig).
   SensorInputs(ros::NodeHandle nh, const SensorInputsConfig& config, const std::string& frame_id,
-               double max_range, const tf2_ros::Buffer& tf_buffer, EnqueueScan enqueue);
+               double max_range, double depth_no_return_length, const tf2_ros::Buffer& tf_buffer,
+               EnqueueScan enqueue);
 
   /// Every input stops taking messages (SensorInput::stop).
   void stop();

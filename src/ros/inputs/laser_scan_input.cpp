@@ -14,16 +14,11 @@ LaserScanInput::~LaserScanInput() { stop(); }
 
 void LaserScanInput::convertAndEnqueue(const sensor_msgs::LaserScan& scan,
                                        const Eigen::Isometry3d& map_from_sensor) {
-  try {
-    std::size_t skipped = 0;
-    mvog::Scan converted =
-        laserScanToScan(scan, map_from_sensor, max_range_,
-                        static_cast<std::size_t>(context_.config.max_points_per_message), skipped);
-    context_.counters.readings_rejected += skipped;
-    context_.enqueue(std::move(converted), "LaserScan");
-  } catch (const InvalidMessage& e) {
-    rejectMessage("LaserScan", e.what());
-  }
+  enqueueConverted("LaserScan", [&](std::size_t& skipped) {
+    return laserScanToScan(scan, map_from_sensor, max_range_,
+                           static_cast<std::size_t>(context_.config.max_points_per_message),
+                           skipped);
+  });
 }
 
 }  // namespace mvog_ros

@@ -14,17 +14,14 @@ PointCloudInput::~PointCloudInput() { stop(); }
 
 void PointCloudInput::convertAndEnqueue(const sensor_msgs::PointCloud2& cloud,
                                         const Eigen::Isometry3d& map_from_sensor) {
-  try {
+  enqueueConverted("PointCloud2", [&](std::size_t& skipped) {
     mvog::Scan converted = pointCloudToScan(
         cloud, map_from_sensor, static_cast<std::size_t>(context_.config.max_points_per_message));
     if (context_.config.voxel_filter_size > 0.0) {
-      context_.counters.readings_rejected +=
-          voxelFilter(converted.hits, context_.config.voxel_filter_size);
+      skipped = voxelFilter(converted.hits, context_.config.voxel_filter_size);
     }
-    context_.enqueue(std::move(converted), "PointCloud2");
-  } catch (const InvalidMessage& e) {
-    rejectMessage("PointCloud2", e.what());
-  }
+    return converted;
+  });
 }
 
 }  // namespace mvog_ros

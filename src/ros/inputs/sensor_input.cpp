@@ -12,12 +12,13 @@ constexpr double kTransformRetryPeriod = 0.01;  // s between checks for awaited 
 }  // namespace
 
 InputStatistics InputCounters::statistics() const {
-  return {messages_dropped_tf.load(), messages_dropped_invalid.load(), readings_rejected.load()};
+  return {messages_dropped_tf.load(), messages_dropped_invalid.load(),
+          messages_dropped_camera_info.load(), readings_rejected.load()};
 }
 
 void InputCounters::reset() {
-  for (std::atomic<std::uint64_t>* counter :
-       {&messages_dropped_tf, &messages_dropped_invalid, &readings_rejected}) {
+  for (std::atomic<std::uint64_t>* counter : {&messages_dropped_tf, &messages_dropped_invalid,
+                                              &messages_dropped_camera_info, &readings_rejected}) {
     counter->store(0);
   }
 }

@@ -38,13 +38,16 @@ void StatisticsPublication::diagnose(diagnostic_updater::DiagnosticStatusWrapper
       since_previous(s.messages_dropped_queue, previous_.messages_dropped_queue);
   const std::uint64_t dropped_invalid =
       since_previous(s.messages_dropped_invalid, previous_.messages_dropped_invalid);
-  if (dropped_tf + dropped_queue + dropped_invalid > 0) {
+  const std::uint64_t dropped_camera_info =
+      since_previous(s.messages_dropped_camera_info, previous_.messages_dropped_camera_info);
+  if (dropped_tf + dropped_queue + dropped_invalid + dropped_camera_info > 0) {
     status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
                     "dropping messages: %llu without transform, %llu for a full insertion queue, "
-                    "%llu invalid since the last report",
+                    "%llu invalid, %llu without camera info since the last report",
                     static_cast<unsigned long long>(dropped_tf),
                     static_cast<unsigned long long>(dropped_queue),
-                    static_cast<unsigned long long>(dropped_invalid));
+                    static_cast<unsigned long long>(dropped_invalid),
+                    static_cast<unsigned long long>(dropped_camera_info));
   } else {
     status.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "%llu messages inserted",
                     static_cast<unsigned long long>(s.messages_inserted));
@@ -68,6 +71,7 @@ void StatisticsPublication::diagnose(diagnostic_updater::DiagnosticStatusWrapper
   status.add("messages_dropped_tf", s.messages_dropped_tf);
   status.add("messages_dropped_queue", s.messages_dropped_queue);
   status.add("messages_dropped_invalid", s.messages_dropped_invalid);
+  status.add("messages_dropped_camera_info", s.messages_dropped_camera_info);
 }
 
 mvog::MapStatistics StatisticsPublication::statistics() {
@@ -104,6 +108,7 @@ mvog::MapStatistics StatisticsPublication::statistics() {
   statistics.messages_dropped_tf = inputs.messages_dropped_tf;
   statistics.messages_dropped_queue = insertion.messages_dropped_queue;
   statistics.messages_dropped_invalid = inputs.messages_dropped_invalid;
+  statistics.messages_dropped_camera_info = inputs.messages_dropped_camera_info;
   statistics.header.frame_id = frame_id_;
   statistics.header.stamp = ros::Time::now();
   return statistics;

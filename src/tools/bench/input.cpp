@@ -10,7 +10,8 @@ std::size_t InputData::readings() const {
   return total;
 }
 
-InputData loadInput(const std::string& path, const std::string& fixed_frame) {
+InputData loadInput(const std::string& path, const std::string& fixed_frame,
+                    double depth_no_return_length) {
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError(path + ": cannot open the file (missing or unreadable)");
   static const std::string kBagMagic = "#ROSBAG V2.0\n";
@@ -20,7 +21,7 @@ InputData loadInput(const std::string& path, const std::string& fixed_frame) {
   file.close();
   InputData input;
   if (head == kBagMagic) {
-    input = loadBag(path, fixed_frame);
+    input = loadBag(path, fixed_frame, depth_no_return_length);
   } else if (path.size() >= 6 && path.compare(path.size() - 6, 6, ".graph") == 0) {
     input = loadScanGraph(path);
   } else {
@@ -30,6 +31,7 @@ InputData loadInput(const std::string& path, const std::string& fixed_frame) {
     throw InputError(path + ": no obstacle readings to insert (" +
                      std::to_string(input.sensor_messages) + " sensor messages, " +
                      std::to_string(input.without_transform) + " without a transform, " +
+                     std::to_string(input.without_camera_info) + " without camera info, " +
                      std::to_string(input.invalid_messages) + " malformed)");
   }
   return input;

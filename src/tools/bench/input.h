@@ -27,11 +27,14 @@ struct InputData {
   std::vector<mvog::Scan> scans;
   /// The out-of-range readings of each scan (at the sensor's range_max).
   std::vector<std::vector<Eigen::Vector3f>> out_of_range;
-  std::size_t sensor_messages = 0;        ///< LaserScan/PointCloud2 messages or graph nodes
+  /// LaserScan, PointCloud2 and depth Image messages, or graph nodes
+  std::size_t sensor_messages = 0;
   std::size_t without_transform = 0;      ///< messages skipped: no transform to the fixed frame
+  std::size_t without_camera_info = 0;    ///< depth images skipped: no camera info of their stamp
   std::size_t invalid_messages = 0;       ///< messages skipped: malformed
   std::size_t out_of_range_readings = 0;  ///< +Inf / beyond range_max (in out_of_range)
   std::size_t skipped_beams = 0;          ///< NaN, -Inf or below range_min: no information
+  std::size_t skipped_pixels = 0;         ///< depth pixels 0, NaN, -Inf: no information
   std::size_t non_finite_points = 0;      ///< cloud points with a NaN or infinite coordinate
 
   /// Obstacle readings over all scans.
@@ -39,12 +42,18 @@ struct InputData {
 };
 
 /// Reads a ROS bag (by its "#ROSBAG V2.0" header) or an OctoMap ScanGraph (.graph).
-/// Throws InputError for a missing, unreadable, truncated or unusable file.
-InputData loadInput(const std::string& path, const std::string& fixed_frame);
+/// `depth_no_return_length`: where the out-of-range readings of a bag's depth images end (m;
+/// infinite: their +Inf pixels are skipped). Throws InputError for a missing, unreadable,
+/// truncated or unusable file.
+InputData loadInput(const std::string& path, const std::string& fixed_frame,
+                    double depth_no_return_length);
 
-/// Every LaserScan and PointCloud2 of the bag, with each message's pose looked up in a tf2 buffer
-/// holding every /tf and /tf_static message of the bag.
-InputData loadBag(const std::string& path, const std::string& fixed_frame);
+/// Every LaserScan, PointCloud2 and depth image (Image of encoding 16UC1 or 32FC1, with the
+/// CameraInfo of its stamp on the sibling `camera_info` topic) of the bag, with each message's
+/// pose looked up in a tf2 buffer holding every /tf and /tf_static message of the bag. Images of
+/// other encodings (colour, mono) are not range data and are not read.
+InputData loadBag(const std::string& path, const std::string& fixed_frame,
+                  double depth_no_return_length);
 
 /// Every node of an OctoMap ScanGraph binary file, parsed with every count checked against the
 /// file size first (a truncated or corrupt file is an error, never a partial graph).

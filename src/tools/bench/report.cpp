@@ -188,12 +188,13 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                input.format.c_str(), report.load_seconds);
   std::fprintf(out,
                "readings    %zu obstacle readings in %zu scans (of %zu sensor messages); "
-               "out-of-range: %zu (%s); disregarded: %zu invalid beams, %zu non-finite points; "
-               "skipped messages: %zu without transform, %zu malformed\n",
+               "out-of-range: %zu (%s); disregarded: %zu invalid beams, %zu invalid pixels, "
+               "%zu non-finite points; skipped messages: %zu without transform, %zu without "
+               "camera info, %zu malformed\n",
                readings, input.scans.size(), input.sensor_messages, input.out_of_range_readings,
                report.out_of_range ? "given to MVOG only" : "disregarded by both backends",
-               input.skipped_beams, input.non_finite_points, input.without_transform,
-               input.invalid_messages);
+               input.skipped_beams, input.skipped_pixels, input.non_finite_points,
+               input.without_transform, input.without_camera_info, input.invalid_messages);
   if (std::isfinite(report.max_range)) {
     std::fprintf(out, "max range   %.2f m\n", report.max_range);
   } else {
@@ -367,8 +368,10 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
       .add("readings", readings)
       .add("out_of_range_disregarded", input.out_of_range_readings)
       .add("invalid_beams", input.skipped_beams)
+      .add("invalid_pixels", input.skipped_pixels)
       .add("non_finite_points", input.non_finite_points)
       .add("messages_without_transform", input.without_transform)
+      .add("messages_without_camera_info", input.without_camera_info)
       .add("malformed_messages", input.invalid_messages)
       .add("load_seconds", report.load_seconds);
   JsonObject document;
