@@ -128,6 +128,7 @@ add_rostest(test/data/newcollege.test)
 add_rostest(test/data/intel_lab.test)
 add_rostest(test/data/people_stationary.test)
 add_rostest(test/data/forgetting.test)
+add_rostest(test/data/multi_robot.test)
 add_rostest(test/data/tum.test)
 add_rostest(test/data/kurt3d.test)
 
