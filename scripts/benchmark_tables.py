@@ -113,6 +113,49 @@ def main(out):
                  "Table I: MVOG", "Table I: OctoMap", "MVOG file", "OctoMap .ot file"], memory))
     print("\n### Threads (0.05 m)\n")
     print(table(["file", "1 thread (s)", "2 threads (s)", "speed-up", "same map"], threads))
+    def quality_at(run, resolution=0.05):
+        q = by_resolution(run["quality"], "mvog").get(resolution)
+        return (f"{percent(q['endpoints_occupied_percent'])} / "
+                f"{percent(q['along_rays_free_percent'])}") if q else "-"
+
+    rules = {file_name(p, "rule_"): load(p) for p in glob.glob(f"{out}/rule_*.json")}
+    rule_columns = [("clip_off", "clip free space at hits: off"),
+                    ("per_reading", "mass counting: per reading"),
+                    ("split_off", "split free space at obstacles: off"),
+                    ("threshold_0.5", "threshold 0.5")]
+    rule_rows = [[name, quality_at(run)] +
+                 [quality_at(rules[f"{key}_{name}"]) if f"{key}_{name}" in rules else "-"
+                  for key, _ in rule_columns] +
+                 [quality_at(paper[name]) if name in paper else "-"]
+                 for name, run in runs.items()]
+    if rules:
+        print("\n### The rules one at a time (MVOG, 0.05 m: ends occupied / along rays free, %)\n")
+        print(table(["file", "defaults"] + [title for _, title in rule_columns] + ["paper model"],
+                    rule_rows))
+    lengths = ["1", "2", "4", "inf"]
+    out_of_range_rows = [[name, quality_at(runs[name])] +
+                         [quality_at(rules[f"out_of_range_{n}_{name}"]) for n in lengths]
+                         for name in runs if f"out_of_range_2_{name}" in rules]
+    if out_of_range_rows:
+        print("\n### Free length of out-of-range readings (MVOG, 0.05 m: ends occupied / along "
+              "rays free, %)\n")
+        print(table(["file", "disregarded"] + [f"{n} m" if n != "inf" else "unbounded"
+                                              for n in lengths], out_of_range_rows))
+
+    table_one_rows = []
+    for path in sorted(glob.glob(f"{out}/table_one_*.json")):
+        name = file_name(path, "table_one_")
+        for t in sorted(load(path)["table_one"], key=lambda t: -t["resolution"]):
+            table_one_rows.append([
+                name, f"{t['resolution']:g}", megabytes(t["point_cloud_bytes"]),
+                megabytes(t["voxel_grid_bytes"]), megabytes(t["octomap_bytes"]),
+                megabytes(t["mvog_bytes"]), f"{t['mvog_bytes'] / t['octomap_bytes']:.2f}"])
+    if table_one_rows:
+        print("\n### Table I's accounting (MB: 12 bytes a point; 4 a voxel of the smallest grid "
+              "holding every ray; OctoMap's pruned tree; 12 bytes a volume + 8 a cell)\n")
+        print(table(["data", "res (m)", "point cloud", "voxel grid", "OctoMap", "MVOG",
+                     "MVOG / OctoMap"], table_one_rows))
+
     instructions = []
     for path in sorted(glob.glob(f"{out}/instructions_mvog_*")):
         name = os.path.basename(path)[len("instructions_mvog_"):]

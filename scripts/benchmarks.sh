@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Every figure of BENCHMARKS.md, from a fresh clone: installs what is missing, builds (Release),
 # runs mvog_bench on every shared recording (MVOG, OctoMap and the bare walk on the same rays, in
-# one run per file), MVOG with 2 threads and with the paper's model, mvog_microbench, and the
+# one run per file), MVOG with 2 threads, with the paper's model and with each of its rules
+# changed alone (README's decisions table: the quality each default buys), mvog_microbench, and the
 # instruction counts of the three insertions (callgrind: the ratios the machine's load cannot
 # disturb); writes the outputs (JSON and text) to OUT and prints the report's tables
 # (scripts/benchmark_tables.py).
-#   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~25 min here)
+#   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~30 min here)
 # MVOG_BENCH_REPEAT (default 3): insertions per backend, the fastest reported.
 # shellcheck source=scripts/common.sh
 source "$(dirname "$0")/common.sh"
@@ -44,6 +45,35 @@ for file in "${FILES[@]}"; do
   run_bench "all_$file" --input "$MVOG_DATA_DIR/$file" "${resolutions[@]}" --backend all
   run_bench "paper_$file" --input "$MVOG_DATA_DIR/$file" "${resolutions[@]}" --backend mvog \
     --model paper
+done
+# The rules one at a time, MVOG alone at 0.05 m on every file (the quality only: one insertion).
+declare -A RULE_OPTIONS=(
+  [clip_off]="--clip-free-space-at-hits off" [per_reading]="--mass-counting per-reading"
+  [split_off]="--split-free-space-at-obstacles off" [threshold_0.5]="--occupancy-threshold 0.5"
+)
+# The free length of out-of-range readings, on the recordings that have them (by default both
+# backends disregard them, as the paper's Table I; the server frees 2 m of each).
+OUT_OF_RANGE_FILES=(newcollege_excerpt.bag intel_lab.bag people_stationary.bag)
+for file in "${FILES[@]}"; do
+  for rule in "${!RULE_OPTIONS[@]}"; do
+    read -r -a options <<<"${RULE_OPTIONS[$rule]}"
+    REPEAT=1 run_bench "rule_${rule}_$file" --input "$MVOG_DATA_DIR/$file" --resolution 0.05 \
+      --backend mvog "${options[@]}"
+  done
+done
+for file in "${OUT_OF_RANGE_FILES[@]}"; do
+  for length in 1 2 4 inf; do
+    REPEAT=1 run_bench "rule_out_of_range_${length}_$file" --input "$MVOG_DATA_DIR/$file" \
+      --resolution 0.05 --backend mvog --out-of-range-free-length "$length"
+  done
+done
+# The paper's Table I: its New College resolutions, and its office room's on the TUM frames (a
+# Kinect indoors) and on Kurt3D (one insertion: only the sizes are read).
+REPEAT=1 run_bench table_one_newcollege_excerpt.bag --input "$MVOG_DATA_DIR/newcollege_excerpt.bag" \
+  --resolution 1.0 --resolution 0.5 --resolution 0.1 --backend both
+for file in tum_fr2_pioneer_slam2_10frames.graph kurt3d_3scans.graph; do
+  REPEAT=1 run_bench "table_one_$file" --input "$MVOG_DATA_DIR/$file" --resolution 0.1 \
+    --resolution 0.05 --resolution 0.02 --backend both
 done
 for file in "${THREADED_FILES[@]}"; do
   run_bench "threads2_$file" --input "$MVOG_DATA_DIR/$file" --resolution 0.05 --backend mvog \

@@ -100,14 +100,15 @@ in_asan_workspace() {
   cat "$asan_reports"/* 2>/dev/null || true
   return 1
 }
-asan_ros_tests=(mapper_node decay bad_input time_jump kill_during_save overload)
+asan_ros_tests=(mapper_node decay bad_input time_jump kill_during_save overload planning)
 mkdir -p "$asan_workspace/src"
 # shellcheck disable=SC2031 # in_asan_workspace's subshell sources setup.bash, unseen: not REPO
 ln -sfn "$REPO" "$asan_workspace/src/mvog"
 if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS="$sanitize -fno-omit-frame-pointer" \
   -DCMAKE_EXE_LINKER_FLAGS="$sanitize" -DCMAKE_SHARED_LINKER_FLAGS="$sanitize" \
-  -DCATKIN_ENABLE_TESTING=ON -j2 mvog_node test_mvog_ros test_mapper_node mvog_generate_messages); then
+  -DCATKIN_ENABLE_TESTING=ON -j2 mvog_node test_mvog_ros test_mapper_node test_planning_node \
+  mvog_generate_messages); then
   check asan-ros-gtests in_asan_workspace "$asan_workspace/devel/lib/mvog/test_mvog_ros"
   for test in "${asan_ros_tests[@]}"; do
     check "asan-rostest-$test" in_asan_workspace rostest mvog "$test.test"

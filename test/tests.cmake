@@ -102,7 +102,7 @@ endif()
 mvog_add_gtest(test_mvog_ros
   SOURCES test/ros/test_map_paths.cpp test/ros/test_mapper_config.cpp
           test/ros/test_visualization.cpp test/ros/test_incremental_grid.cpp
-          test/ros/test_insertion_worker.cpp
+          test/ros/test_insertion_worker.cpp test/ros/test_planning_messages.cpp
   LIBRARIES mvog_ros)
 # The server through its ROS interface, as node and as nodelet (test/ros/*.test).
 find_package(rostest REQUIRED)
@@ -112,6 +112,10 @@ add_dependencies(test_mapper_node mvog_node)  # started by RefusedStart.*
 add_rostest(test/ros/mapper_nodelet.test DEPENDENCIES test_mapper_node)
 add_rostest(test/ros/decay.test DEPENDENCIES test_mapper_node)
 add_rostest(test/ros/refused_start.test DEPENDENCIES test_mapper_node)
+# What planners and explorers ask the server (test/ros/planning.test).
+add_rostest_gtest(test_planning_node test/ros/planning.test test/ros/test_planning_node.cpp)
+target_link_libraries(test_planning_node mvog_ros)
+add_dependencies(test_planning_node mvog_node)
 # Reliability (test/reliability, RELIABILITY.md): bad input, time jumping back, SIGKILL during
 # autosaves, a sensor faster than the mapper. Each test node starts its own mvog_node.
 add_rostest(test/reliability/bad_input.test DEPENDENCIES mvog_node)

@@ -7,6 +7,7 @@
 #include <ros/node_handle.h>
 
 #include "mvog/config.h"
+#include "mvog/planning_config.h"
 
 namespace mvog_ros {
 
@@ -77,10 +78,12 @@ struct PublicationsConfig {
   void validate(const mvog::MapConfig& map) const;
 };
 
-/// The query services (QueryServices).
+/// The query services (QueryServices, PlanningServices).
 struct QueryServicesConfig {
-  double tf_timeout = 0.2;         // s to wait for the transform of a query's frame
-  int max_query_points = 1000000;  // larger ~get_occupancy requests are refused
+  double tf_timeout = 0.2;  // s to wait for the transform of a query's frame
+  // larger ~get_occupancy requests are refused, and ~check_segments, ~check_boxes requests of
+  // more segments or boxes
+  int max_query_points = 1000000;
 
   void validate() const;
 };
@@ -112,6 +115,11 @@ struct MapperConfig {
   PublicationsConfig publications;
   QueryServicesConfig queries;
   MapFilesConfig map_files;
+  // What planners and explorers ask (PlanningServices, PlanningPublication, the traversable map
+  // of GridPublication): ~max_query_cells, ~frontier_min_z, ~frontier_max_z (by default the
+  // projection band), ~frontier_min_cells, ~robot_height, ~max_step, ~traversable_min_z,
+  // ~traversable_max_z; its occupancy_threshold is ~occupancy_threshold (fromParameters sets it).
+  mvog::PlanningConfig planning;
 
   /// Throws mvog::ConfigError naming the first invalid parameter.
   void validate() const;

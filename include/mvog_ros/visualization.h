@@ -10,6 +10,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "mvog/map.h"
+#include "mvog/surfaces.h"
 
 namespace mvog_ros {
 
@@ -35,6 +36,7 @@ visualization_msgs::Marker deleteAllMarker(const std::string& frame_id, const ro
 /// The occupancy grid value of a probability (0..100) or of unknown (-1).
 std::int8_t gridValue(float probability);
 std::int8_t gridValue(mvog::OccupancyState state);
+std::int8_t gridValue(mvog::Traversability traversability);
 
 /// A nav_msgs/OccupancyGrid of a core grid, at height `z` (the grid's origin height).
 template <class T>
@@ -59,9 +61,9 @@ class IncrementalGrid {
   IncrementalGrid(double z, std::int64_t max_cells, Compute compute)
       : z_(z), max_cells_(max_cells), compute_(std::move(compute)) {}
 
-  /// Brings the grid up to date with the tiles changed (modified or removed) since the last
-  /// update; tiles outside the layout are passed over. Returns the rectangle that changed (for an
-  /// OccupancyGridUpdate), or the whole grid after a re-layout.
+  /// Brings the grid up to date with the tiles changed since the last update (those outside the
+  /// grid are passed over). Returns the rectangle that changed (for an OccupancyGridUpdate), or
+  /// the whole grid after a re-layout.
   /// Throws GridTooLarge (and forgets the grid) if the map's bounds need more than max_cells.
   mvog::CellRange update(const mvog::Map& map, const std::vector<mvog::TileIndex>& changed,
                          bool& relaid_out);

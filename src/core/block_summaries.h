@@ -75,7 +75,7 @@ class BlockSummaries {
   struct Summary {
     std::vector<Extent> free;        ///< heights where every cell is free, the faces excluded
     std::optional<Extent> occupied;  ///< from the lowest to the highest occupied height of a cell
-    std::array<CellFree, kBlockSize * kBlockSize> cells;  ///< row by row
+    std::array<CellFree, std::size_t{kBlockSize} * kBlockSize> cells;  ///< row by row
   };
   /// The blocks of one tile.
   struct TileBlocks {

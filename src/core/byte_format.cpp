@@ -1,5 +1,7 @@
 #include "byte_format.h"
 
+#include "tile_block.h"
+
 namespace mvog {
 namespace detail {
 namespace {
@@ -48,10 +50,10 @@ std::string readCell(Reader& reader, std::uint64_t volumes_left, CellIndex& cell
   cell = CellIndex{reader.i32(), reader.i32()};
   const std::uint64_t num_positive = reader.u32();
   const std::uint64_t num_negative = reader.u32();
-  const std::string where = "cell (" + std::to_string(cell.x) + ", " + std::to_string(cell.y) + ")";
-  if (num_positive + num_negative == 0) return where + " holds no volume";
+  // Every cell of a file or an update passes here: its name is made only for a message.
+  if (num_positive + num_negative == 0) return cellName(cell).append(" holds no volume");
   if (num_positive + num_negative > volumes_left) {
-    return where + " holds more volumes than the header counts";
+    return cellName(cell).append(" holds more volumes than the header counts");
   }
   volumes.positive.resize(num_positive);
   volumes.negative.resize(num_negative);

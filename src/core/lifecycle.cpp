@@ -177,6 +177,7 @@ std::optional<std::vector<TileIndex>> Map::tilesRemovedSince(std::uint64_t revis
              keys.end());
   std::sort(keys.begin(), keys.end(), detail::rowMajorBefore);
   std::vector<TileIndex> removed;
+  removed.reserve(keys.size());
   for (std::uint64_t key : keys) removed.push_back({detail::tileKeyX(key), detail::tileKeyY(key)});
   return removed;
 }

@@ -174,26 +174,29 @@ void Map::setCellVolumes(const std::vector<CellAssignment>& cells) {
   std::unordered_set<std::uint64_t> seen;
   for (const CellAssignment& assignment : cells) {
     const CellIndex& c = assignment.cell;
-    const std::string where = "cell (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ")";
+    // The cell's name is made only for a message: this loop checks every cell assigned.
+    auto refuse = [&](const std::string& problem) {
+      throw ConfigError(detail::cellName(c).append(problem));
+    };
     // Readings within max_coordinate fall in cells |i|, |j| <= max_coordinate * s + 1.
     if (std::fabs(static_cast<double>(c.x)) > max_cell ||
         std::fabs(static_cast<double>(c.y)) > max_cell) {
-      throw ConfigError(where + " lies beyond max_coordinate");
+      refuse(" lies beyond max_coordinate");
     }
     if (!seen.insert((std::uint64_t{static_cast<std::uint32_t>(c.x)} << 32) |
                      static_cast<std::uint32_t>(c.y))
              .second) {
-      throw ConfigError(where + " is given twice");
+      refuse(" is given twice");
     }
     const CellVolumes& v = assignment.volumes;
     const std::string problem =
         checkColumn(v.positive.data(), v.positive.size(), v.negative.data(), v.negative.size(),
                     config_.rules.split_free_space_at_obstacles);
-    if (!problem.empty()) throw ConfigError(where + ": " + problem);
+    if (!problem.empty()) refuse(": " + problem);
     for (const std::vector<Volume>* list : {&v.positive, &v.negative}) {
       for (const Volume& volume : *list) {
         if (!std::isfinite(static_cast<float>(volume.mass / mass_unit_))) {
-          throw ConfigError(where + ": a mass is too large for the map's decayed unit");
+          refuse(": a mass is too large for the map's decayed unit");
         }
       }
     }

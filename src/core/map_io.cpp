@@ -12,6 +12,7 @@
 #include <unordered_set>
 
 #include "byte_format.h"
+#include "tile_block.h"
 
 namespace mvog {
 namespace {
@@ -126,7 +127,7 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     const std::uint64_t key = (std::uint64_t{static_cast<std::uint32_t>(cell.x)} << 32) |
                               static_cast<std::uint32_t>(cell.y);
     if (!seen.insert(key).second) {
-      fail("cell (" + std::to_string(cell.x) + ", " + std::to_string(cell.y) + ") appears twice");
+      fail(detail::cellName(cell).append(" appears twice"));
     }
     volumes_read += assignment.volumes.positive.size() + assignment.volumes.negative.size();
   }

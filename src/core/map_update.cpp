@@ -42,11 +42,6 @@ constexpr std::size_t kTileRecordBytes = 16;
   throw MapFileError("invalid map update: " + what);
 }
 
-std::string tileName(std::uint64_t key) {
-  return "tile (" + std::to_string(detail::tileKeyX(key)) + ", " +
-         std::to_string(detail::tileKeyY(key)) + ")";
-}
-
 using detail::UpdateBody;
 using detail::UpdateHeader;
 
@@ -139,7 +134,7 @@ UpdateBody readBody(const std::uint8_t* data, const UpdateHeader& header) {
     const std::uint64_t key = detail::tileKey(tile_x, reader.i32());
     const std::int64_t exponent = reader.i32();
     const std::uint32_t num_cells = reader.u32();
-    const std::string where = tileName(key);
+    const std::string where = detail::tileName(key);
     if (!body.tiles.empty() && !detail::rowMajorBefore(body.tiles.back().first, key)) {
       fail(where + " is out of order or listed twice");
     }
@@ -157,20 +152,22 @@ UpdateBody readBody(const std::uint8_t* data, const UpdateHeader& header) {
     for (std::uint32_t c = 0; c < num_cells; ++c) {
       const std::string problem = detail::readCell(reader, volumes_left, cell, volumes);
       if (!problem.empty()) fail(problem);
-      const std::string cell_name =
-          "cell (" + std::to_string(cell.x) + ", " + std::to_string(cell.y) + ")";
-      if (detail::tileKeyOf(cell) != key) fail(cell_name + " is not in " + where);
+      // The cell's name is made only for a message: this loop reads every cell of an update.
+      auto fail_at_cell = [&](const std::string& what) {
+        fail(detail::cellName(cell).append(what));
+      };
+      if (detail::tileKeyOf(cell) != key) fail_at_cell(" is not in " + where);
       const auto local = static_cast<int>(detail::localIndex(cell));
-      if (local <= previous_local) fail(cell_name + " is out of order or listed twice");
+      if (local <= previous_local) fail_at_cell(" is out of order or listed twice");
       previous_local = local;
       if (std::fabs(static_cast<double>(cell.x)) > max_cell ||
           std::fabs(static_cast<double>(cell.y)) > max_cell) {
-        fail(cell_name + " lies beyond max_coordinate");
+        fail_at_cell(" lies beyond max_coordinate");
       }
       const std::string invalid =
           checkColumn(volumes.positive.data(), volumes.positive.size(), volumes.negative.data(),
                       volumes.negative.size(), split);
-      if (!invalid.empty()) fail(cell_name + ": " + invalid);
+      if (!invalid.empty()) fail_at_cell(": " + invalid);
       volumes_left -= volumes.positive.size() + volumes.negative.size();
       builder.add(static_cast<unsigned>(local), volumes.positive, volumes.negative);
     }

@@ -10,6 +10,21 @@
 namespace mvog {
 namespace detail {
 
+namespace {
+std::string pairName(const char* what, std::int32_t x, std::int32_t y) {
+  std::string name = what;
+  name += " (";
+  name += std::to_string(x);
+  name += ", ";
+  name += std::to_string(y);
+  name += ')';
+  return name;
+}
+}  // namespace
+
+std::string cellName(const CellIndex& cell) { return pairName("cell", cell.x, cell.y); }
+std::string tileName(std::uint64_t key) { return pairName("tile", tileKeyX(key), tileKeyY(key)); }
+
 TileBlock::~TileBlock() { std::free(block_); }
 
 TileBlock& TileBlock::operator=(TileBlock&& other) noexcept {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "mvog/cell_index.h"
@@ -47,6 +48,9 @@ inline bool rowMajorBefore(std::uint64_t a, std::uint64_t b) {
 inline CellIndex tileOrigin(std::uint64_t key) {
   return {tileKeyX(key) * kTileSize, tileKeyY(key) * kTileSize};
 }
+/// "cell (x, y)" and "tile (x, y)", as error messages name them.
+std::string cellName(const CellIndex& cell);
+std::string tileName(std::uint64_t key);
 
 /// A cell's two lists, as stored (masses in the tile's unit).
 struct ColumnRef {

@@ -6,19 +6,22 @@
 
 namespace mvog_ros {
 
-Mapper::Mapper(ros::NodeHandle nh, ros::NodeHandle private_nh)
+Mapper::Mapper(const ros::NodeHandle& nh, ros::NodeHandle private_nh)
     : config_(MapperConfig::fromParameters(private_nh)),
       map_(initialMap(config_.map_files, config_.map)),
       tf_listener_(tf_buffer_, nh),
       insertion_(config_.insertion, map_),
       markers_(private_nh, config_.publications, config_.frame_id, config_.occupancy_threshold,
                map_),
-      grids_(private_nh, config_.publications, config_.frame_id, config_.occupancy_threshold,
-             config_.max_cross_section_cells, map_),
+      grids_(private_nh, config_.publications, config_.planning, config_.frame_id,
+             config_.occupancy_threshold, config_.max_cross_section_cells, map_),
+      frontiers_and_surfaces_(private_nh, config_.publications, config_.planning, config_.frame_id,
+                              map_),
       binary_map_(private_nh, config_.publications, config_.frame_id, map_),
       map_updates_(private_nh, config_.publications, config_.frame_id, map_),
       queries_(private_nh, config_.queries, config_.frame_id, config_.occupancy_threshold,
                config_.max_cross_section_cells, config_.map.max_coordinate, map_, tf_buffer_),
+      checks_(private_nh, config_.queries, config_.planning, config_.frame_id, map_, tf_buffer_),
       map_files_(private_nh, config_.map_files, map_,
                  [this](mvog::Map&& map) { replaceMap(std::move(map)); }),
       map_edits_(private_nh, config_.frame_id, config_.queries.tf_timeout,
@@ -67,6 +70,7 @@ void Mapper::replaceMap(mvog::Map&& map) {
   }
   markers_.restartIfReplaced();
   grids_.restartIfReplaced();
+  frontiers_and_surfaces_.restartIfReplaced();
 }
 
 void Mapper::decay(const ros::TimerEvent&) {

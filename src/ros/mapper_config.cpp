@@ -46,7 +46,8 @@ void read(const ros::NodeHandle& nh, const std::string& name, T& value) {
   }
 }
 
-void read(const ros::NodeHandle& nh, const std::string& name, int& value) {
+template <class Integer>
+void readInteger(const ros::NodeHandle& nh, const std::string& name, Integer& value) {
   if (!nh.hasParam(name)) return;
   // roscpp's getParam(int) would round a float silently: accept only whole numbers.
   XmlRpc::XmlRpcValue raw;
@@ -56,13 +57,24 @@ void read(const ros::NodeHandle& nh, const std::string& name, int& value) {
     return;
   }
   if (raw.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+    // XML-RPC integers have 32 bits: a larger whole number comes as a double. Below max + 1:
+    // exact for int, and without 2^63 itself (which int64 cannot hold) for int64.
     const double number = static_cast<double>(raw);
-    if (std::trunc(number) == number && std::fabs(number) <= std::numeric_limits<int>::max()) {
-      value = static_cast<int>(number);
+    if (std::trunc(number) == number &&
+        std::fabs(number) < static_cast<double>(std::numeric_limits<Integer>::max()) + 1.0) {
+      value = static_cast<Integer>(number);
       return;
     }
   }
   throw mvog::ConfigError("~" + name + ": must be an integer");
+}
+
+void read(const ros::NodeHandle& nh, const std::string& name, int& value) {
+  readInteger(nh, name, value);
+}
+
+void read(const ros::NodeHandle& nh, const std::string& name, std::int64_t& value) {
+  readInteger(nh, name, value);
 }
 
 void read(const ros::NodeHandle& nh, const std::string& name, double& value) {
@@ -225,6 +237,7 @@ void MapperConfig::validate() const {
   publications.validate(map);
   queries.validate();
   map_files.validate();
+  validateCoreConfig(planning);
 }
 
 MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
@@ -274,6 +287,19 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
 
   read(nh, "tf_timeout", config.queries.tf_timeout);
   read(nh, "max_query_points", config.queries.max_query_points);
+
+  mvog::PlanningConfig& planning = config.planning;
+  planning.occupancy_threshold = config.occupancy_threshold;
+  planning.frontier_min_z = publications.projection_min_z;
+  planning.frontier_max_z = publications.projection_max_z;
+  read(nh, "max_query_cells", planning.max_query_cells);
+  read(nh, "frontier_min_z", planning.frontier_min_z);
+  read(nh, "frontier_max_z", planning.frontier_max_z);
+  read(nh, "frontier_min_cells", planning.frontier_min_cells);
+  read(nh, "robot_height", planning.robot_height);
+  read(nh, "max_step", planning.max_step);
+  read(nh, "traversable_min_z", planning.traversable_min_z);
+  read(nh, "traversable_max_z", planning.traversable_max_z);
 
   MapFilesConfig& map_files = config.map_files;
   read(nh, "map_directory", map_files.map_directory);

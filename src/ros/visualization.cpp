@@ -138,6 +138,10 @@ std::int8_t gridValue(mvog::OccupancyState state) {
   return -1;
 }
 
+std::int8_t gridValue(mvog::Traversability traversability) {
+  return static_cast<std::int8_t>(traversability);  // its values are those of OccupancyGrid
+}
+
 template <class T>
 nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::Grid2D<T>& grid, double z,
                                         const std::string& frame_id, const ros::Time& stamp) {
@@ -160,6 +164,8 @@ nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::Grid2D<T>& grid, double z,
 template nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::CrossSection&, double,
                                                  const std::string&, const ros::Time&);
 template nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::Projection&, double,
+                                                 const std::string&, const ros::Time&);
+template nav_msgs::OccupancyGrid toOccupancyGrid(const mvog::TraversableMap&, double,
                                                  const std::string&, const ros::Time&);
 
 mvog::CellRange IncrementalGrid::update(const mvog::Map& map,
@@ -198,8 +204,8 @@ mvog::CellRange IncrementalGrid::update(const mvog::Map& map,
   mvog::CellRange touched = kNoCells;
   for (const mvog::TileIndex& tile : changed) {
     const mvog::CellRange cells = mvog::Map::tileCells(tile);
-    // The layout is made of whole tiles and holds every tile the map had since it was made: a
-    // tile outside it came and went since.
+    // The grid covers whole tiles: one that begins outside it (a tile the map removed, beyond a
+    // layout that moved with the map's bounds) lies wholly outside.
     if (!cells_.contains(cells.min)) continue;
     write(cells, compute_(map, cells));
     touched =

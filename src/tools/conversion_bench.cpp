@@ -5,6 +5,7 @@
 // each message costs to serialise and deserialise (once per connection). One 640 x 480 frame of a
 // closed room (Kinect-like intrinsics): every pixel is a hit. Counters: s_per_Mpx, the time per
 // million pixels.
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -59,12 +60,14 @@ sensor_msgs::Image depthImage(const std::string& encoding) {
   image.step = kWidth * pixel_bytes;
   image.data.resize(std::size_t{image.step} * kHeight);
   for (std::size_t k = 0; k < kPixels; ++k) {
-    const Eigen::Vector3d ray((static_cast<double>(k % kWidth) - info.K[2]) / info.K[0],
-                              (static_cast<double>(k / kWidth) - info.K[5]) / info.K[4], 1.0);
+    const std::size_t row = k / kWidth;
+    const std::size_t column = k % kWidth;
+    const Eigen::Vector3d ray((static_cast<double>(column) - info.K[2]) / info.K[0],
+                              (static_cast<double>(row) - info.K[5]) / info.K[4], 1.0);
     const double depth =
         scene.castRay(pose.translation(), (pose.linear() * ray).normalized()) / ray.norm();
     if (pixel_bytes == 2) {
-      const auto millimetres = static_cast<std::uint16_t>(1000.0 * depth + 0.5);
+      const auto millimetres = static_cast<std::uint16_t>(std::lround(1000.0 * depth));
       std::memcpy(image.data.data() + 2 * k, &millimetres, 2);
     } else {
       const auto metres = static_cast<float>(depth);
@@ -81,8 +84,11 @@ void backProjectIntoCloud(const sensor_msgs::Image& image, const sensor_msgs::Ca
   std::size_t skipped = 0;
   const mvog::Scan points = mvog_ros::depthImageToScan(image, info, Eigen::Isometry3d::Identity(),
                                                        mvog::DepthImageConfig{}, kNoLimit, skipped);
-  cloud.data.resize(points.hits.size() * sizeof(Eigen::Vector3f));
-  std::memcpy(cloud.data.data(), points.hits.data(), cloud.data.size());
+  constexpr std::size_t kPointBytes = 3 * sizeof(float);
+  cloud.data.resize(points.hits.size() * kPointBytes);
+  for (std::size_t k = 0; k < points.hits.size(); ++k) {
+    std::memcpy(cloud.data.data() + k * kPointBytes, points.hits[k].data(), kPointBytes);
+  }
 }
 
 sensor_msgs::PointCloud2 cloudLayout() {

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -142,13 +143,12 @@ inline double castRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& d) {
   return nearest;
 }
 
-inline Map scannedRoomMap() {
-  MapConfig config;
-  config.resolution = kSceneResolution;
-  Map map(config);
+/// The scans of the scanned room, one per pose.
+inline std::vector<Scan> scannedRoomScans() {
   constexpr double kMaxRange = 8.0;
   const Eigen::Vector3d poses[] = {
       {-1.5, 0.0, 1.2}, {1.5, 0.8, 1.2}, {0.0, -1.0, 1.2}, {2.0, -1.2, 1.2}, {2.3, -1.0, 0.4}};
+  std::vector<Scan> scans;
   for (const Eigen::Vector3d& origin : poses) {
     Scan scan;
     scan.origin = origin;
@@ -165,8 +165,16 @@ inline Map scannedRoomMap() {
         }
       }
     }
-    map.insertScan(scan);
+    scans.push_back(std::move(scan));
   }
+  return scans;
+}
+
+inline Map scannedRoomMap() {
+  MapConfig config;
+  config.resolution = kSceneResolution;
+  Map map(config);
+  for (const Scan& scan : scannedRoomScans()) map.insertScan(scan);
   return map;
 }
 

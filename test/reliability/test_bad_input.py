@@ -18,7 +18,10 @@ import unittest
 
 import rospy
 import rostest
+from geometry_msgs.msg import Point
 from tf2_msgs.msg import TFMessage
+
+from mvog.srv import CheckBoxes, CheckSegments
 
 import mvog_reliability as rel
 
@@ -354,6 +357,61 @@ class BadInput(unittest.TestCase):
         record("get_occupancy in an unknown frame", "refused: \"%s\"" %
                response.message.split("\n")[0][:110])
 
+    def test_planning_queries(self):
+        """check_segments and check_boxes refuse what they cannot answer, saying why."""
+        snapshot = self.server.snapshot()
+        check_segments = self.server.service("check_segments", CheckSegments)
+        check_boxes = self.server.service("check_boxes", CheckBoxes)
+
+        def segments(pairs, radius=0.0, frame_id=""):
+            return check_segments(frame_id=frame_id, radius=radius,
+                                  starts=[Point(*a) for a, _ in pairs],
+                                  ends=[Point(*b) for _, b in pairs])
+
+        def boxes(pairs, frame_id=""):
+            return check_boxes(frame_id=frame_id, min_corners=[Point(*a) for a, _ in pairs],
+                               max_corners=[Point(*b) for _, b in pairs])
+
+        response = segments([])
+        self.assertTrue(response.success, response.message)
+        self.assertEqual(len(response.state), 0)
+        record("check_segments with no segment", "success, empty answer")
+        good = ((0.0, 0.0, 0.5), (1.0, 0.0, 0.5))
+        refused = [
+            ("check_segments with more ends than starts",
+             lambda: check_segments(starts=[Point(*good[0])], ends=[Point(*good[1])] * 2)),
+            ("check_segments with ~max_query_points + 1 segments",
+             lambda: segments([good] * (MAX_QUERY_POINTS + 1))),
+            ("check_segments with a NaN point", lambda: segments([((NAN, 0.0, 0.5), good[1])])),
+            ("check_segments with an infinite point",
+             lambda: segments([(good[0], (INF, 0.0, 0.5))])),
+            ("check_segments with a point beyond ~max_coordinate",
+             lambda: segments([(good[0], (1e300, 0.0, 0.5))])),
+            ("check_segments with a NaN radius", lambda: segments([good], radius=NAN)),
+            ("check_segments with a negative radius", lambda: segments([good], radius=-0.1)),
+            ("check_segments over more than ~max_query_cells cells",
+             lambda: segments([((-9000.0, 0.0, 0.5), (9000.0, 0.0, 0.5))], radius=100.0)),
+            ("check_segments in an unknown frame", lambda: segments([good], frame_id="nowhere")),
+            ("check_boxes with more max corners than min corners",
+             lambda: check_boxes(min_corners=[Point(*good[0])], max_corners=[Point(*good[1])] * 2)),
+            ("check_boxes with ~max_query_points + 1 boxes",
+             lambda: boxes([good] * (MAX_QUERY_POINTS + 1))),
+            ("check_boxes with a min corner above its max corner",
+             lambda: boxes([(good[1], good[0])])),
+            ("check_boxes with a NaN corner", lambda: boxes([((NAN, 0.0, 0.0), good[1])])),
+            ("check_boxes over more than ~max_query_cells cells",
+             lambda: boxes([((-9000.0, -9000.0, 0.0), (9000.0, 9000.0, 1.0))])),
+            ("check_boxes in an unknown frame", lambda: boxes([good], frame_id="nowhere")),
+        ]
+        for what, request in refused:
+            response = request()
+            self.assertFalse(response.success, what)
+            self.assertTrue(response.message, what)
+            self.assertEqual(len(response.state), 0, what)
+            record(what, "refused: \"%s\"" % response.message.split("\n")[0][:140])
+        self.assertEqual(self.server.snapshot(), snapshot)
+        self.assertTrue(self.server.alive())
+
     def test_paths(self):
         outside = tempfile.mkdtemp(prefix="mvog_reliability_outside_")
         try:
@@ -429,6 +487,9 @@ class BadInput(unittest.TestCase):
                  ("occupancy_threshold", {"occupancy_threshold": NAN}),
                  ("projection_min_z", {"projection_min_z": 2.0, "projection_max_z": 1.0}),
                  ("max_query_points", {"max_query_points": 0}),
+                 ("max_query_cells", {"max_query_cells": 0}),
+                 ("robot_height", {"robot_height": 0.0}),
+                 ("frontier_min_z", {"frontier_min_z": 2.0, "frontier_max_z": 1.0}),
                  ("depth_stride", {"depth_stride": 0}),
                  ("autosave_period", {"autosave_period": -5.0})]
         for k, (parameter, values) in enumerate(cases):

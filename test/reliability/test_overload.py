@@ -5,7 +5,8 @@ Clouds of 60,000 points are published at 30 Hz, far faster than a mapper at 5 cm
 while a client asks ~get_occupancy for 2,000 points ten times a second. Checked: the server stays
 up, answers every query, counts whole messages dropped from its insertion queue
 (messages_dropped_queue), never counts a message twice, keeps the newest (the last cloud, seen
-from elsewhere, is in the map). Printed: how many messages were
+from elsewhere, is in the map), and says so on /diagnostics: its status is a warning while it
+drops messages, and OK again once it no longer does. Printed: how many messages were
 inserted, dropped and counted, and lost without being counted (roscpp's own subscriber queue,
 ~sensor_queue_size long, drops silently), query latencies and the server's RSS. Nothing is
 asserted about time.
@@ -18,6 +19,7 @@ import unittest
 import numpy as np
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 
 import mvog_reliability as rel
 
@@ -46,6 +48,13 @@ class Overload(unittest.TestCase):
         newest = wall_cloud(99, behind=True)  # behind the camera: only this one maps there
         latencies, failures, rss = [], [], []
         done = threading.Event()
+        levels = []  # of the server's status on /diagnostics, in order
+
+        def on_diagnostics(array):
+            levels.extend(status.level for status in array.status
+                          if status.name == "mapper_overload: mapping")
+
+        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics)
 
         def query():
             random = np.random.default_rng(1)
@@ -77,6 +86,10 @@ class Overload(unittest.TestCase):
             behind = [(-3.0, 0.0, 1.0), (-3.0, 1.0, 1.5)]
             rel.wait_for(lambda: list(server.occupancy(behind).state) == [OCCUPIED, OCCUPIED],
                          "the newest cloud in the map", timeout=120.0)
+            # Nothing dropped since: the status is OK again.
+            seen = len(levels)
+            rel.wait_for(lambda: len(levels) > seen and levels[-1] == DiagnosticStatus.OK,
+                         "an OK status on /diagnostics once nothing is dropped", timeout=30.0)
         finally:
             done.set()
             querier.join()
@@ -100,6 +113,9 @@ class Overload(unittest.TestCase):
         self.assertEqual(statistics.messages_dropped_invalid, 0)
         self.assertLessEqual(counted, published, "a message was counted twice")
         self.assertGreater(statistics.messages_inserted, 0)
+        if statistics.messages_dropped_queue > 0:
+            self.assertIn(DiagnosticStatus.WARN, levels,
+                          "messages were dropped, and /diagnostics never warned")
 
 
 if __name__ == "__main__":

@@ -1,13 +1,16 @@
 // IncrementalGrid (mvog_ros/visualization.h): a 2D layer of the map kept up to date tile by
 // tile, laid out over whole tiles around the map with a margin, re-laid out when the map
-// outgrows it, refused beyond its largest size.
+// outgrows it, refused beyond its largest size; and the tiles it is given (tilesChangedSince,
+// mvog_ros/publications/change_publication.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "mvog/map.h"
+#include "mvog_ros/publications/change_publication.h"
 #include "mvog_ros/visualization.h"
 
 namespace mvog_ros {
@@ -201,6 +204,55 @@ TEST(IncrementalGrid, ClearForgetsTheLayout) {
   grid.update(map, {}, relaid_out);  // the next update lays it out afresh, whatever changed
   EXPECT_TRUE(relaid_out);
   EXPECT_EQ(grid.grid().data, expectedData(map, grid));
+}
+
+TEST(IncrementalGrid, ARemovedTileBecomesUnknownAndTilesOutsideArePassedOver) {
+  IncrementalGrid grid = crossSectionGrid();
+  mvog::Map map = oneReadingLaidOut(grid);
+  mapReading(map, 0.05, 2.05, 0.55);  // tiles (0, 0) and (1, 0)
+  bool relaid_out = false;
+  grid.update(map, map.tilesModifiedSince(0), relaid_out);
+  const std::uint64_t revision = map.revision();
+  // Every cell of tile (1, 0) emptied: the map removes the tile, which tilesModifiedSince does
+  // not list, tilesChangedSince does.
+  std::vector<mvog::Map::CellAssignment> emptied;
+  for (std::int32_t y = 0; y < kTile; ++y) {
+    for (std::int32_t x = kTile; x < 2 * kTile; ++x) emptied.push_back({{x, y}, {}});
+  }
+  map.setCellVolumes(emptied);
+  EXPECT_TRUE(map.tilesModifiedSince(revision).empty());
+  const std::optional<std::vector<mvog::TileIndex>> changed = tilesChangedSince(map, revision);
+  ASSERT_TRUE(changed.has_value());
+  ASSERT_EQ(changed->size(), 1u);
+  EXPECT_EQ(changed->front(), (mvog::TileIndex{1, 0}));
+  const mvog::CellRange touched = grid.update(map, *changed, relaid_out);
+  EXPECT_FALSE(relaid_out);
+  EXPECT_EQ(touched.min, (mvog::CellIndex{kTile, 0}));
+  EXPECT_EQ(grid.grid().data, expectedData(map, grid));
+  // A tile beyond the layout has nothing to show.
+  const nav_msgs::OccupancyGrid::_data_type before = grid.grid().data;
+  EXPECT_TRUE(grid.update(map, {{1000, 1000}, {-1000, 3}}, relaid_out).empty());
+  EXPECT_EQ(grid.grid().data, before);
+}
+
+TEST(TilesChangedSince, ModifiedAndRemovedTilesInRowsFromTheLowestOrNothingAfterAClear) {
+  mvog::Map map = emptyMap();
+  mapReading(map, -1.55, 1.55, 0.05);        // tiles (-1, 0) and (0, 0)
+  mapReading(map, 0.05, 0.05 + 1.0, -1.05);  // tile (0, -1)
+  const std::uint64_t revision = map.revision();
+  map.setCellVolumes({5, -11}, {});                // tile (0, -1) keeps other cells: modified
+  mapReading(map, 2.05, 2.55, 2.05);               // tile (1, 1), new
+  std::vector<mvog::Map::CellAssignment> emptied;  // tile (-1, 0) removed
+  for (std::int32_t y = 0; y < kTile; ++y) {
+    for (std::int32_t x = -kTile; x < 0; ++x) emptied.push_back({{x, y}, {}});
+  }
+  map.setCellVolumes(emptied);
+  const std::optional<std::vector<mvog::TileIndex>> changed = tilesChangedSince(map, revision);
+  ASSERT_TRUE(changed.has_value());
+  EXPECT_EQ(*changed, (std::vector<mvog::TileIndex>{{0, -1}, {-1, 0}, {1, 1}}));
+  EXPECT_EQ(tilesChangedSince(map, map.revision()), std::vector<mvog::TileIndex>{});
+  map.clear();  // the map no longer knows which tiles went
+  EXPECT_FALSE(tilesChangedSince(map, revision).has_value());
 }
 
 }  // namespace

@@ -70,6 +70,14 @@ TEST(MapperConfig, AcceptsSensibleNonDefaultValues) {
   config.map_files.autosave_period = 60.0;
   config.queries.max_query_points = 1;
   config.max_cross_section_cells = 1 << 28;
+  config.planning.max_query_cells = std::int64_t{1} << 40;
+  config.planning.frontier_min_z = 0.2;
+  config.planning.frontier_max_z = 0.2;
+  config.planning.frontier_min_cells = 1;
+  config.planning.robot_height = 1.8;
+  config.planning.max_step = 0.0;
+  config.planning.traversable_min_z = -kInf;
+  config.planning.traversable_max_z = kInf;
   EXPECT_EQ(refusal(config), "");
   config.publications.projection_min_z = config.publications.projection_max_z =
       1.0;  // a single height
@@ -124,6 +132,10 @@ TEST(MapperConfig, RefusesNaNInfiniteNegativeOrZeroNumbers) {
   add(
       "autosave_period", [](MapperConfig& c) -> double& { return c.map_files.autosave_period; },
       true);
+  add(
+      "robot_height", [](MapperConfig& c) -> double& { return c.planning.robot_height; }, false);
+  add(
+      "max_step", [](MapperConfig& c) -> double& { return c.planning.max_step; }, true);
   for (const InvalidCase& invalid : cases) expectRefused(invalid);
 }
 
@@ -175,6 +187,11 @@ TEST(MapperConfig, RefusesOutOfRangeValues) {
        [](MapperConfig& c) { c.publications.binary_map_period = 1e10; }},
       {"autosave_period", "beyond ros::Duration",
        [](MapperConfig& c) { c.map_files.autosave_period = 1e10; }},
+      {"max_query_cells", "0", [](MapperConfig& c) { c.planning.max_query_cells = 0; }},
+      {"max_query_cells", "< 0", [](MapperConfig& c) { c.planning.max_query_cells = -1; }},
+      {"frontier_min_cells", "0", [](MapperConfig& c) { c.planning.frontier_min_cells = 0; }},
+      {"occupancy_threshold", "of the planning queries",
+       [](MapperConfig& c) { c.planning.occupancy_threshold = 1.0; }},
   };
   for (const InvalidCase& invalid : cases) expectRefused(invalid);
 }
@@ -210,6 +227,19 @@ TEST(MapperConfig, RefusesContradictoryValues) {
        [](MapperConfig& c) {
          c.publications.cross_section_heights = {c.map.max_coordinate + 1.0};
        }},
+      {"frontier_min_z", "> frontier_max_z",
+       [](MapperConfig& c) {
+         c.planning.frontier_min_z = 2.0;
+         c.planning.frontier_max_z = 1.0;
+       }},
+      {"frontier_min_z", "NaN", [](MapperConfig& c) { c.planning.frontier_min_z = kNaN; }},
+      {"frontier_min_z", "a NaN max", [](MapperConfig& c) { c.planning.frontier_max_z = kNaN; }},
+      {"traversable_min_z", "> traversable_max_z",
+       [](MapperConfig& c) {
+         c.planning.traversable_min_z = 0.5;
+         c.planning.traversable_max_z = 0.0;
+       }},
+      {"traversable_min_z", "NaN", [](MapperConfig& c) { c.planning.traversable_min_z = kNaN; }},
       {"autosave_file", "empty while autosaving",
        [](MapperConfig& c) {
          c.map_files.autosave_period = 10.0;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <mutex>
 #include <optional>
 #include <vector>
@@ -11,12 +12,18 @@
 
 namespace mvog_ros {
 
-/// What MarkerPublication and GridPublication share: every ~publish_period they publish what
-/// changed in the map since they last did (the tiles modified or removed since: forgetting, the
-/// window, ~clear_box), and once the map was replaced (~load_map, ~reset), or it cannot tell
-/// which tiles went (a mirror's full update), they first clear what they showed and publish every
-/// tile. Their connection callbacks take the same lock (mutex_, then the map's) to send a new
-/// subscriber everything.
+/// The tiles of `map` modified after `revision` and those removed after it (which hold nothing
+/// now), rows of tiles from the lowest; nothing if the map no longer knows which tiles it removed
+/// since then (Map::tilesRemovedSince).
+std::optional<std::vector<mvog::TileIndex>> tilesChangedSince(const mvog::Map& map,
+                                                              std::uint64_t revision);
+
+/// What MarkerPublication, GridPublication and PlanningPublication share: every ~publish_period
+/// they publish what changed in the map since they last did (the tiles modified or removed
+/// since: tilesChangedSince; all of them afresh if the map cannot tell), and once the map was
+/// replaced (~load_map, ~reset) they first clear what they showed of the previous one. Their
+/// connection callbacks take the same lock (mutex_, then the map's) to send a new subscriber
+/// everything.
 class ChangePublication {
  public:
   virtual ~ChangePublication();
@@ -36,8 +43,8 @@ class ChangePublication {
   void stop();
   /// Under mutex_ and the map's lock.
   void restartIfReplacedLocked();
-  /// The tiles removed, then those modified, since what the publication shows; nothing if the
-  /// map cannot tell which tiles it removed (under mutex_ and the map's lock).
+  /// tilesChangedSince what the publication shows: nothing if the map cannot tell which tiles
+  /// it removed, as after a mirror's full update (under mutex_ and the map's lock).
   std::optional<std::vector<mvog::TileIndex>> changedSincePublished() const;
 
   /// Clears what was published of the previous map (under mutex_ and the map's lock).

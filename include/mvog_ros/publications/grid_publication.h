@@ -7,6 +7,7 @@
 
 #include <ros/ros.h>
 
+#include "mvog/planning_config.h"
 #include "mvog_ros/mapper_config.h"
 #include "mvog_ros/publications/change_publication.h"
 #include "mvog_ros/shared_map.h"
@@ -14,22 +15,28 @@
 
 namespace mvog_ros {
 
-/// ~projected_map (the band [~projection_min_z, ~projection_max_z]: occupied, free or unknown)
-/// and ~cross_section_K (p at the K-th of ~cross_section_heights) as nav_msgs/OccupancyGrid,
-/// latched, each kept up to date tile by tile (IncrementalGrid): every ~publish_period the grid
-/// if it changed, and on ~..._updates (map_msgs/OccupancyGridUpdate) the rectangle that changed.
-/// No grid larger than ~max_cross_section_cells is published.
+/// ~projected_map (the band [~projection_min_z, ~projection_max_z]: occupied, free or unknown),
+/// ~cross_section_K (p at the K-th of ~cross_section_heights) and ~traversable_map (where a
+/// ground robot can go: mvog::traversableMap) as nav_msgs/OccupancyGrid, latched, each kept up to
+/// date tile by tile (IncrementalGrid): every ~publish_period the grid if it changed, and on
+/// ~..._updates (map_msgs/OccupancyGridUpdate) the rectangle that changed. No grid larger than
+/// ~max_cross_section_cells is published.
 class GridPublication : public ChangePublication {
  public:
+  /// `planning`: the robot and the band of the traversable map.
   GridPublication(ros::NodeHandle& private_nh, const PublicationsConfig& config,
-                  const std::string& frame_id, double occupancy_threshold,
-                  int max_cross_section_cells, const SharedMap& shared_map);
+                  const mvog::PlanningConfig& planning, const std::string& frame_id,
+                  double occupancy_threshold, int max_cross_section_cells,
+                  const SharedMap& shared_map);
   ~GridPublication() override;
 
  private:
   /// One grid: the projected map, or one cross-section.
   struct Layer {
     IncrementalGrid grid;
+    /// Whether a cell's value depends on its four neighbours (the traversable map): a change of
+    /// a tile changes its neighbour tiles too.
+    bool reads_neighbours;
     ros::Publisher publisher;
     ros::Publisher updates_publisher;
   };
@@ -45,7 +52,8 @@ class GridPublication : public ChangePublication {
 
   const std::string frame_id_;
   const int max_cross_section_cells_;
-  std::vector<Layer> layers_;  // the projected map, then one per ~cross_section_heights entry
+  // The projected map, one per ~cross_section_heights entry, the traversable map.
+  std::vector<Layer> layers_;
 };
 
 }  // namespace mvog_ros

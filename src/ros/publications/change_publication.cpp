@@ -1,8 +1,25 @@
 #include "mvog_ros/publications/change_publication.h"
 
+#include <algorithm>
+#include <iterator>
 #include <shared_mutex>
 
 namespace mvog_ros {
+
+std::optional<std::vector<mvog::TileIndex>> tilesChangedSince(const mvog::Map& map,
+                                                              std::uint64_t revision) {
+  const std::optional<std::vector<mvog::TileIndex>> removed = map.tilesRemovedSince(revision);
+  if (!removed) return std::nullopt;
+  const std::vector<mvog::TileIndex> modified = map.tilesModifiedSince(revision);
+  std::vector<mvog::TileIndex> changed;
+  changed.reserve(modified.size() + removed->size());
+  // Both lists are rows of tiles from the lowest, and no tile is in both.
+  std::merge(modified.begin(), modified.end(), removed->begin(), removed->end(),
+             std::back_inserter(changed), [](const mvog::TileIndex& a, const mvog::TileIndex& b) {
+               return a.y != b.y ? a.y < b.y : a.x < b.x;
+             });
+  return changed;
+}
 
 ChangePublication::ChangePublication(const SharedMap& shared_map) : map_(shared_map) {}
 
@@ -27,12 +44,7 @@ void ChangePublication::restartIfReplacedLocked() {
 }
 
 std::optional<std::vector<mvog::TileIndex>> ChangePublication::changedSincePublished() const {
-  std::optional<std::vector<mvog::TileIndex>> changed =
-      map_.map.tilesRemovedSince(published_.revision);
-  if (!changed) return std::nullopt;
-  const std::vector<mvog::TileIndex> modified = map_.map.tilesModifiedSince(published_.revision);
-  changed->insert(changed->end(), modified.begin(), modified.end());
-  return changed;
+  return tilesChangedSince(map_.map, published_.revision);
 }
 
 void ChangePublication::publishChanges(const ros::TimerEvent&) {
@@ -41,7 +53,7 @@ void ChangePublication::publishChanges(const ros::TimerEvent&) {
   restartIfReplacedLocked();
   if (map_.version() == published_) return;
   std::optional<std::vector<mvog::TileIndex>> changed = changedSincePublished();
-  if (!changed) {
+  if (!changed) {  // the map no longer knows which tiles it removed: show it afresh
     clearPublished();
     changed = map_.map.tilesModifiedSince(0);
   }

@@ -6,11 +6,15 @@
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
 
+#include "mvog/tile_changes.h"
+#include "mvog_ros/planning_messages.h"
+
 namespace mvog_ros {
 
 GridPublication::GridPublication(ros::NodeHandle& private_nh, const PublicationsConfig& config,
-                                 const std::string& frame_id, double occupancy_threshold,
-                                 int max_cross_section_cells, const SharedMap& shared_map)
+                                 const mvog::PlanningConfig& planning, const std::string& frame_id,
+                                 double occupancy_threshold, int max_cross_section_cells,
+                                 const SharedMap& shared_map)
     : ChangePublication(shared_map),
       frame_id_(frame_id),
       max_cross_section_cells_(max_cross_section_cells) {
@@ -18,6 +22,7 @@ GridPublication::GridPublication(ros::NodeHandle& private_nh, const Publications
   const double max_z = config.projection_max_z;
   std::vector<IncrementalGrid> grids;
   std::vector<std::string> topics;
+  std::vector<bool> reads_neighbours;
   grids.emplace_back(
       min_z, max_cross_section_cells,
       [min_z, max_z, occupancy_threshold](const mvog::Map& map, const mvog::CellRange& cells) {
@@ -26,6 +31,7 @@ GridPublication::GridPublication(ros::NodeHandle& private_nh, const Publications
             .data;
       });
   topics.push_back("projected_map");
+  reads_neighbours.push_back(false);
   for (std::size_t k = 0; k < config.cross_section_heights.size(); ++k) {
     const double height = config.cross_section_heights[k];
     grids.emplace_back(
@@ -34,13 +40,23 @@ GridPublication::GridPublication(ros::NodeHandle& private_nh, const Publications
           return toOccupancyGrid(map.crossSection(height, cells), height, "", ros::Time()).data;
         });
     topics.push_back("cross_section_" + std::to_string(k));
+    reads_neighbours.push_back(false);
     ROS_INFO("mvog: ~%s is the cross-section at z = %.3f m", topics.back().c_str(), height);
   }
+  // Drawn at the height of the band nearest z = 0, the ground of a map frame by REP-105.
+  grids.emplace_back(std::clamp(0.0, planning.traversable_min_z, planning.traversable_max_z),
+                     max_cross_section_cells,
+                     [planning](const mvog::Map& map, const mvog::CellRange& cells) {
+                       return traversableGridData(map, cells, planning);
+                     });
+  topics.push_back("traversable_map");
+  reads_neighbours.push_back(true);
   // A subscriber's connection callback may run on another thread as soon as its topic is
   // advertised: it waits for the layers to be complete.
   std::lock_guard<std::mutex> publication_lock(mutex_);
   for (std::size_t k = 0; k < grids.size(); ++k) {
-    layers_.push_back({std::move(grids[k]), ros::Publisher(), ros::Publisher()});
+    layers_.push_back(
+        {std::move(grids[k]), reads_neighbours[k], ros::Publisher(), ros::Publisher()});
     layers_[k].publisher = private_nh.advertise<nav_msgs::OccupancyGrid>(
         topics[k], 1,
         [this, k](const ros::SingleSubscriberPublisher& subscriber) { send(subscriber, k); },
@@ -111,7 +127,8 @@ std::optional<mvog::CellRange> GridPublication::update(Layer& layer,
                                                        const std::vector<mvog::TileIndex>& changed,
                                                        bool& relaid_out) {
   try {
-    return layer.grid.update(map_.map, changed, relaid_out);
+    return layer.grid.update(
+        map_.map, layer.reads_neighbours ? mvog::withNeighbourTiles(changed) : changed, relaid_out);
   } catch (const GridTooLarge& e) {
     ROS_WARN_THROTTLE(kWarningPeriod,
                       "mvog: %s not published: %s, more than ~max_cross_section_cells (%d); "

@@ -3,9 +3,7 @@
 #include <cmath>
 #include <shared_mutex>
 
-#include <Eigen/Geometry>
-
-#include "mvog_ros/frames.h"
+#include "mvog_ros/services/query_requests.h"
 #include "mvog_ros/visualization.h"
 
 namespace mvog_ros {
@@ -28,28 +26,20 @@ QueryServices::QueryServices(ros::NodeHandle& private_nh, const QueryServicesCon
 
 bool QueryServices::getOccupancy(mvog::GetOccupancy::Request& request,
                                  mvog::GetOccupancy::Response& response) {
-  if (request.points.size() > static_cast<std::size_t>(config_.max_query_points)) {
-    response.message = "refused: " + std::to_string(request.points.size()) +
-                       " points exceed ~max_query_points (" +
-                       std::to_string(config_.max_query_points) + ")";
+  if (!withinMaxQueryPoints(request.points.size(), "points", config_.max_query_points,
+                            response.message)) {
     return true;
   }
-  Eigen::Isometry3d map_from_frame = Eigen::Isometry3d::Identity();
-  if (!request.frame_id.empty() && request.frame_id != frame_id_) {
-    try {
-      map_from_frame = latestTransform(tf_buffer_, frame_id_, request.frame_id, config_.tf_timeout);
-    } catch (const TransformUnavailable& e) {
-      response.message = e.what();
-      return true;
-    }
-  }
+  const std::optional<Eigen::Isometry3d> map_from_frame = mapFromQueryFrame(
+      tf_buffer_, frame_id_, request.frame_id, config_.tf_timeout, response.message);
+  if (!map_from_frame) return true;
   response.probability.resize(request.points.size());
   response.state.resize(request.points.size());
   std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
   for (std::size_t k = 0; k < request.points.size(); ++k) {
     const geometry_msgs::Point& p = request.points[k];
     const mvog::PointOccupancy occupancy =
-        map_.map.occupancy(map_from_frame * Eigen::Vector3d(p.x, p.y, p.z));
+        map_.map.occupancy(*map_from_frame * Eigen::Vector3d(p.x, p.y, p.z));
     response.probability[k] = occupancy.probability.value_or(std::nanf(""));
     response.state[k] = static_cast<std::uint8_t>(occupancy.state(occupancy_threshold_));
   }
