@@ -122,11 +122,17 @@ add_rostest(test/reliability/bad_input.test DEPENDENCIES mvog_node)
 add_rostest(test/reliability/time_jump.test DEPENDENCIES mvog_node)
 add_rostest(test/reliability/kill_during_save.test DEPENDENCIES mvog_node)
 add_rostest(test/reliability/overload.test DEPENDENCIES mvog_node)
+# A map's lifetime (test/lifecycle): ~clear_box and ~merge_map, the local window, mirrors.
+add_rostest(test/lifecycle/map_edits.test DEPENDENCIES mvog_node)
+add_rostest(test/lifecycle/window.test DEPENDENCIES mvog_node)
+add_rostest(test/lifecycle/mirror.test DEPENDENCIES mvog_node mvog_mirror)
 # Replays of the recordings in $MVOG_DATA_DIR (default ../shared/data) through mapper.launch,
 # checked against the data's README (test/data). Skipped without the data unless CI=true.
 add_rostest(test/data/newcollege.test)
 add_rostest(test/data/intel_lab.test)
 add_rostest(test/data/people_stationary.test)
+add_rostest(test/data/forgetting.test)
+add_rostest(test/data/multi_robot.test)
 add_rostest(test/data/tum.test)
 add_rostest(test/data/kurt3d.test)
 

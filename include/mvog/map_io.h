@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mvog/map.h"
@@ -157,6 +158,11 @@ class MapMirror {
   /// unit grown).
   MapUpdateResult apply(const std::uint8_t* data, std::size_t size);
   const Map& map() const { return map_; }
+  /// Exchanges the mirror's map with `other`, for a caller that keeps the map where others read
+  /// it under a lock (a server's shared map): it swaps the map in before apply() and back out
+  /// after. Anything else done to the map meanwhile makes the updates that follow describe
+  /// another map than the one they are applied to.
+  void swapMap(Map& other) noexcept { std::swap(map_, other); }
   /// The source's revision the map equals (0: no full update applied yet).
   std::uint64_t sourceRevision() const { return source_revision_; }
 

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <deque>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -46,6 +47,8 @@ class InsertionWorker {
 
   InsertionStatistics statistics() const;
   void resetStatistics();
+  /// Where the latest scan inserted was taken from (its origin, map frame), if any was.
+  std::optional<Eigen::Vector3d> latestOrigin() const;
 
  private:
   struct QueuedScan {
@@ -75,6 +78,8 @@ class InsertionWorker {
   std::atomic<std::uint64_t> out_of_range_readings_{0};
   std::atomic<std::uint64_t> obstacle_nanoseconds_{0};
   std::atomic<std::uint64_t> out_of_range_nanoseconds_{0};
+  mutable std::mutex origin_mutex_;
+  std::optional<Eigen::Vector3d> latest_origin_;  // under origin_mutex_
 
   std::thread thread_;  // last: it runs on the members above
 };

@@ -7,12 +7,15 @@
 #include "mvog/map.h"
 #include "mvog_ros/inputs/sensor_inputs.h"
 #include "mvog_ros/insertion_worker.h"
+#include "mvog_ros/local_window.h"
 #include "mvog_ros/mapper_config.h"
 #include "mvog_ros/publications/binary_map_publication.h"
 #include "mvog_ros/publications/grid_publication.h"
+#include "mvog_ros/publications/map_update_publication.h"
 #include "mvog_ros/publications/marker_publication.h"
 #include "mvog_ros/publications/planning_publication.h"
 #include "mvog_ros/publications/statistics_publication.h"
+#include "mvog_ros/services/map_edit_services.h"
 #include "mvog_ros/services/map_file_services.h"
 #include "mvog_ros/services/planning_services.h"
 #include "mvog_ros/services/query_services.h"
@@ -25,16 +28,19 @@ namespace mvog_ros {
 /// (SharedMap) and composes the parts that use them, each with its slice of MapperConfig:
 ///   sensor inputs      subscribe, wait for tf, convert (SensorInputs: inputs/)
 ///   insertion worker   bounded queue and thread, the only writer of readings (InsertionWorker)
-///   publications       markers, grids, frontiers and surfaces, binary map, statistics
-///                      (publications/)
-///   services           queries, segment and box checks, map files and autosave, reset
-///                      (services/)
-/// and decays the map itself. Callbacks may run on several threads at once.
+///   publications       markers, grids, frontiers and surfaces, binary map, map updates,
+///                      statistics (publications/)
+///   services           queries, segment and box checks, map files and autosave, clear_box and
+///                      merge_map, reset (services/)
+///   local window       tiles far from the robot dropped and saved (LocalWindow)
+/// and decays the map itself, forgetting what decay made light. Callbacks may run on several
+/// threads at once.
 class Mapper {
  public:
   /// Throws mvog::ConfigError naming the parameter at fault (~map_file if it cannot be loaded).
   Mapper(const ros::NodeHandle& nh, ros::NodeHandle private_nh);
-  /// Stops the inputs, inserts what is queued, and autosaves once more (with autosave on).
+  /// Stops the inputs, inserts what is queued, writes the dropped tiles not written yet, and
+  /// autosaves once more (with autosave on).
   ~Mapper();
   Mapper(const Mapper&) = delete;
   Mapper& operator=(const Mapper&) = delete;
@@ -57,9 +63,12 @@ class Mapper {
   GridPublication grids_;
   PlanningPublication frontiers_and_surfaces_;
   BinaryMapPublication binary_map_;
+  MapUpdatePublication map_updates_;
   QueryServices queries_;
   PlanningServices checks_;
   MapFileServices map_files_;
+  MapEditServices map_edits_;
+  LocalWindow window_;
   ros::Timer decay_timer_;
   SensorInputs inputs_;
   ResetService reset_;

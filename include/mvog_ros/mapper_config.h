@@ -50,14 +50,28 @@ struct DecayConfig {
   void validate() const;
 };
 
+/// A map's lifetime: forgetting after each decay step (Mapper) and the local window
+/// (LocalWindow).
+struct LifetimeConfig {
+  double forget_mass = 0.0;  // after each decay step, volumes lighter than this go (0: off)
+  double keep_radius = 0.0;  // m (xy) around the robot: tiles wholly farther are dropped (0: off)
+  std::string robot_frame;   // the window's centre; empty: where the latest scan was taken from
+  // In map_directory: the dropped tiles are merged into it (empty: they are discarded).
+  std::string keep_radius_save_file = "dropped_tiles.mvog";
+
+  /// `decay`: forgetting needs it (nothing else makes volumes lighter).
+  void validate(const DecayConfig& decay) const;
+};
+
 /// The publications (MarkerPublication, GridPublication, BinaryMapPublication,
-/// StatisticsPublication).
+/// MapUpdatePublication, StatisticsPublication).
 struct PublicationsConfig {
   std::vector<double> cross_section_heights;  // m, one ~cross_section_K grid each
   double projection_min_z = -std::numeric_limits<double>::infinity();  // band of ~projected_map
   double projection_max_z = std::numeric_limits<double>::infinity();
-  double publish_period = 1.0;     // s, markers and grids (only what changed)
-  double binary_map_period = 5.0;  // s, the whole map on ~map (0: off)
+  double publish_period = 1.0;  // s, markers and grids (only what changed)
+  double binary_map_period =
+      5.0;  // s, the whole map on ~map, what changed on ~map_updates (0: off)
   double statistics_period = 1.0;  // s, ~statistics and /diagnostics
 
   /// `map`: the cross-section heights must lie within its max_coordinate.
@@ -97,6 +111,7 @@ struct MapperConfig {
   SensorInputsConfig inputs;
   InsertionWorkerConfig insertion;
   DecayConfig decay;
+  LifetimeConfig lifetime;
   PublicationsConfig publications;
   QueryServicesConfig queries;
   MapFilesConfig map_files;

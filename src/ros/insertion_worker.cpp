@@ -61,6 +61,10 @@ void InsertionWorker::run() {
     obstacle_nanoseconds_ += static_cast<std::uint64_t>(1e9 * result.obstacle_seconds);
     out_of_range_nanoseconds_ += static_cast<std::uint64_t>(1e9 * result.out_of_range_seconds);
     ++messages_inserted_;
+    {
+      std::lock_guard<std::mutex> lock(origin_mutex_);
+      latest_origin_ = queued.scan.origin;
+    }
     if (result.rejected_out_of_bounds > 0) {
       ROS_WARN_THROTTLE(kWarningPeriod,
                         "mvog: %zu readings of a %s lie beyond ~max_coordinate and were rejected",
@@ -98,6 +102,11 @@ InsertionStatistics InsertionWorker::statistics() const {
   statistics.obstacle_seconds = 1e-9 * static_cast<double>(obstacle_nanoseconds_.load());
   statistics.out_of_range_seconds = 1e-9 * static_cast<double>(out_of_range_nanoseconds_.load());
   return statistics;
+}
+
+std::optional<Eigen::Vector3d> InsertionWorker::latestOrigin() const {
+  std::lock_guard<std::mutex> lock(origin_mutex_);
+  return latest_origin_;
 }
 
 void InsertionWorker::resetStatistics() {

@@ -18,11 +18,17 @@ Mapper::Mapper(const ros::NodeHandle& nh, ros::NodeHandle private_nh)
       frontiers_and_surfaces_(private_nh, config_.publications, config_.planning, config_.frame_id,
                               map_),
       binary_map_(private_nh, config_.publications, config_.frame_id, map_),
+      map_updates_(private_nh, config_.publications, config_.frame_id, map_),
       queries_(private_nh, config_.queries, config_.frame_id, config_.occupancy_threshold,
                config_.max_cross_section_cells, config_.map.max_coordinate, map_, tf_buffer_),
       checks_(private_nh, config_.queries, config_.planning, config_.frame_id, map_, tf_buffer_),
       map_files_(private_nh, config_.map_files, map_,
                  [this](mvog::Map&& map) { replaceMap(std::move(map)); }),
+      map_edits_(private_nh, config_.frame_id, config_.queries.tf_timeout,
+                 config_.map_files.map_directory, map_, tf_buffer_),
+      window_(private_nh, config_.lifetime, config_.frame_id, config_.map_files.map_directory,
+              config_.publications.publish_period, map_, tf_buffer_,
+              [this] { return insertion_.latestOrigin(); }),
       // A depth image's +Inf pixels (no return) free their ray as far as the core would free any
       // out-of-range reading: ~max_range, or the map's out_of_range_free_length if shorter.
       inputs_(
@@ -52,6 +58,7 @@ Mapper::~Mapper() {
   inputs_.stop();
   decay_timer_.stop();
   insertion_.stop();
+  window_.stop();
   // A clean shutdown loses nothing mapped since the last autosave.
   map_files_.autosaveOnShutdown();
 }
@@ -69,6 +76,8 @@ void Mapper::replaceMap(mvog::Map&& map) {
 void Mapper::decay(const ros::TimerEvent&) {
   std::unique_lock<WriterPreferringMutex> lock(map_.mutex);
   map_.map.decay(config_.decay.decay_factor);
+  // Only decay makes volumes lighter: forgetting follows each step (~forget_mass 0: nothing).
+  map_.map.forget(config_.lifetime.forget_mass);
 }
 
 }  // namespace mvog_ros

@@ -183,6 +183,18 @@ void DecayConfig::validate() const {
   requireDuration(decay_period, "decay_period", "off");
 }
 
+void LifetimeConfig::validate(const DecayConfig& decay) const {
+  require(std::isfinite(forget_mass) && forget_mass >= 0.0, "forget_mass",
+          "must be a finite number >= 0 (0: off)");
+  require(forget_mass == 0.0 || decay.enabled(), "forget_mass",
+          "needs decay (~decay_factor < 1 and ~decay_period > 0): nothing else makes volumes "
+          "lighter");
+  require(std::isfinite(keep_radius) && keep_radius >= 0.0, "keep_radius",
+          "must be a finite number >= 0 (0: off)");
+  require(robot_frame.empty() || robot_frame.front() != '/', "robot_frame",
+          "must be a tf2 frame id (without a leading '/'), or empty");
+}
+
 void PublicationsConfig::validate(const mvog::MapConfig& map) const {
   for (double height : cross_section_heights) {
     require(std::isfinite(height) && std::fabs(height) <= map.max_coordinate,
@@ -221,6 +233,7 @@ void MapperConfig::validate() const {
   inputs.validate();
   insertion.validate();
   decay.validate();
+  lifetime.validate(decay);
   publications.validate(map);
   queries.validate();
   map_files.validate();
@@ -257,6 +270,12 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
 
   read(nh, "decay_factor", config.decay.decay_factor);
   read(nh, "decay_period", config.decay.decay_period);
+
+  LifetimeConfig& lifetime = config.lifetime;
+  read(nh, "forget_mass", lifetime.forget_mass);
+  read(nh, "keep_radius", lifetime.keep_radius);
+  read(nh, "robot_frame", lifetime.robot_frame);
+  read(nh, "keep_radius_save_file", lifetime.keep_radius_save_file);
 
   PublicationsConfig& publications = config.publications;
   read(nh, "cross_section_heights", publications.cross_section_heights);

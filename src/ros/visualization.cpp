@@ -173,8 +173,10 @@ mvog::CellRange IncrementalGrid::update(const mvog::Map& map,
                                         bool& relaid_out) {
   relaid_out = false;
   const mvog::CellRange bounds = map.bounds();
-  if (bounds.empty()) return kNoCells;
-  if (cells_.empty() || !cells_.contains(bounds.min) || !cells_.contains(bounds.max)) {
+  if (bounds.empty() && cells_.empty()) return kNoCells;
+  // A map emptied (forgetting, ~clear_box) keeps its layout: its removed tiles become unknown.
+  if (cells_.empty() ||
+      (!bounds.empty() && (!cells_.contains(bounds.min) || !cells_.contains(bounds.max)))) {
     // Re-lay out over whole tiles around the bounds plus a margin, and evaluate it all.
     const mvog::TileIndex low = mvog::Map::tileOf(bounds.min);
     const mvog::TileIndex high = mvog::Map::tileOf(bounds.max);

@@ -121,6 +121,27 @@ TEST(MapUpdate, ADecayStepIsAnUpdateOfNoTileAndIsFollowedExactly) {
   EXPECT_TRUE(mirrors(mirror, source));
 }
 
+TEST(MapUpdate, AMirrorWhoseMapIsKeptElsewhereFollowsWhileItIsSwappedInForEachUpdate) {
+  // A server keeps its map in a place of its own, under its lock: the mirror's map lives there
+  // between updates and is swapped into the mirror for each.
+  Map source = test::randomMap(8, 0.2, 5.0);
+  std::mt19937 rng(8);
+  MapMirror mirror;
+  Map kept;
+  std::uint64_t sent = 0;
+  for (int step = 0; step < 6; ++step) {
+    if (step % 3 == 2) source.decay(0.8);
+    source.insertScan(test::randomScan(rng, test::randomPoint(rng, 3.0, 1.0), 300, 100, 4.0));
+    const Bytes bytes = updateOf(source, sent);
+    sent = source.revision();
+    mirror.swapMap(kept);
+    ASSERT_EQ(applyTo(mirror, bytes).status, MapUpdateStatus::kApplied) << "step " << step;
+    mirror.swapMap(kept);
+    EXPECT_TRUE(mirror.map().empty());
+    ASSERT_EQ(serializeMap(kept), serializeMap(source)) << "step " << step;
+  }
+}
+
 TEST(MapUpdate, ItsSizeGrowsWithWhatChangedNotWithTheMap) {
   // A corridor 40 m long mapped scan by scan, each scan 6 m wide: each update holds what the
   // last scan changed, whatever the length mapped so far.

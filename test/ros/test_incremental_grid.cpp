@@ -4,6 +4,7 @@
 // mvog_ros/publications/change_publication.h).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -120,6 +121,49 @@ TEST(IncrementalGrid, ChangesInsideTheLayoutUpdateOnlyTheirTiles) {
   bool unchanged_relaid_out = true;
   EXPECT_TRUE(grid.update(map, {}, unchanged_relaid_out).empty());  // nothing changed
   EXPECT_FALSE(unchanged_relaid_out);
+}
+
+TEST(IncrementalGrid, RemovedTilesBecomeUnknownAndAnEmptiedMapKeepsItsLayout) {
+  IncrementalGrid grid = crossSectionGrid();
+  mvog::Map map = oneReadingLaidOut(grid);
+  const mvog::CellRange layout = grid.cells();
+  std::uint64_t revision = map.revision();
+  mapReading(map, 0.05, 3.05, 1.65);  // tiles (0, 1) and (1, 1)
+  bool relaid_out = false;
+  grid.update(map, map.tilesModifiedSince(revision), relaid_out);
+  ASSERT_FALSE(relaid_out);
+  revision = map.revision();
+  map.clearBox({0.0, 1.6, -10.0}, {3.2, 3.2, 10.0});  // tiles (0, 1) and (1, 1) go
+  std::vector<mvog::TileIndex> removed = *map.tilesRemovedSince(revision);
+  ASSERT_EQ(removed.size(), 2u);
+  grid.update(map, removed, relaid_out);
+  EXPECT_FALSE(relaid_out);
+  EXPECT_EQ(grid.grid().data, expectedData(map, grid));
+
+  revision = map.revision();
+  map.clearBox({-10.0, -10.0, -10.0}, {10.0, 10.0, 10.0});
+  ASSERT_TRUE(map.empty());
+  removed = *map.tilesRemovedSince(revision);
+  const mvog::CellRange touched = grid.update(map, removed, relaid_out);
+  EXPECT_FALSE(relaid_out);
+  EXPECT_EQ(grid.cells().min, layout.min);
+  EXPECT_EQ(grid.cells().max, layout.max);
+  EXPECT_EQ(touched.min, mvog::Map::tileCells({0, 0}).min);
+  EXPECT_EQ(touched.max, mvog::Map::tileCells({0, 0}).max);
+  EXPECT_TRUE(std::all_of(grid.grid().data.begin(), grid.grid().data.end(),
+                          [](std::int8_t value) { return value == -1; }));
+}
+
+TEST(IncrementalGrid, PassesOverTilesOutsideItsLayout) {
+  IncrementalGrid grid = crossSectionGrid();
+  mvog::Map map = oneReadingLaidOut(grid);
+  const nav_msgs::OccupancyGrid::_data_type before = grid.grid().data;
+  bool relaid_out = false;
+  // A tile that came and went between two updates, far outside the layout.
+  const mvog::CellRange touched = grid.update(map, {{100, 100}}, relaid_out);
+  EXPECT_FALSE(relaid_out);
+  EXPECT_TRUE(touched.empty());
+  EXPECT_EQ(grid.grid().data, before);
 }
 
 TEST(IncrementalGrid, AMapOutgrowingTheLayoutIsLaidOutAgain) {

@@ -270,6 +270,31 @@ TEST(MapperConfig, RefusesEmptyOrInvalidNames) {
   for (const InvalidCase& invalid : cases) expectRefused(invalid);
 }
 
+TEST(MapperConfig, RefusesForgettingWithoutDecayAndBadWindows) {
+  const std::vector<InvalidCase> cases = {
+      {"forget_mass", "without decay", [](MapperConfig& c) { c.lifetime.forget_mass = 0.1; }},
+      {"forget_mass", "negative",
+       [](MapperConfig& c) {
+         c.decay = {0.9, 1.0};
+         c.lifetime.forget_mass = -0.1;
+       }},
+      {"forget_mass", "NaN",
+       [](MapperConfig& c) {
+         c.decay = {0.9, 1.0};
+         c.lifetime.forget_mass = kNaN;
+       }},
+      {"keep_radius", "negative", [](MapperConfig& c) { c.lifetime.keep_radius = -1.0; }},
+      {"keep_radius", "infinite", [](MapperConfig& c) { c.lifetime.keep_radius = kInf; }},
+      {"robot_frame", "with a leading slash",
+       [](MapperConfig& c) { c.lifetime.robot_frame = "/base_link"; }},
+  };
+  for (const InvalidCase& invalid : cases) expectRefused(invalid);
+  MapperConfig config = validConfig();
+  config.decay = {0.9, 1.0};
+  config.lifetime = {0.05, 30.0, "base_link", ""};
+  EXPECT_EQ(refusal(config), "");
+}
+
 TEST(MapperConfig, AnEmptyAutosaveFileIsFineWhileAutosaveIsOff) {
   MapperConfig config = validConfig();
   config.map_files.autosave_file.clear();

@@ -43,6 +43,9 @@ class ChangePublication {
   void stop();
   /// Under mutex_ and the map's lock.
   void restartIfReplacedLocked();
+  /// tilesChangedSince what the publication shows: nothing if the map cannot tell which tiles
+  /// it removed, as after a mirror's full update (under mutex_ and the map's lock).
+  std::optional<std::vector<mvog::TileIndex>> changedSincePublished() const;
 
   /// Clears what was published of the previous map (under mutex_ and the map's lock).
   virtual void clearPublished() = 0;

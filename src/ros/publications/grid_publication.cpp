@@ -110,8 +110,10 @@ void GridPublication::send(const ros::SingleSubscriberPublisher& subscriber, std
   std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
   restartIfReplacedLocked();
   Layer& sent = layers_[layer];
+  const std::optional<std::vector<mvog::TileIndex>> changed = changedSincePublished();
+  if (!changed) sent.grid.clear();  // laid out afresh by the update
   bool relaid_out = false;
-  if (!update(sent, map_.map.tilesModifiedSince(published_.revision), relaid_out) ||
+  if (!update(sent, changed.value_or(std::vector<mvog::TileIndex>{}), relaid_out) ||
       sent.grid.cells().empty()) {  // too large, or nothing mapped yet
     return;
   }

@@ -1,6 +1,6 @@
 #include "mvog_ros/services/query_requests.h"
 
-#include <tf2_eigen/tf2_eigen.h>
+#include "mvog_ros/frames.h"
 
 namespace mvog_ros {
 
@@ -18,10 +18,9 @@ std::optional<Eigen::Isometry3d> mapFromQueryFrame(const tf2_ros::Buffer& tf_buf
                                                    std::string& refusal) {
   if (frame_id.empty() || frame_id == map_frame) return Eigen::Isometry3d::Identity();
   try {
-    return tf2::transformToEigen(
-        tf_buffer.lookupTransform(map_frame, frame_id, ros::Time(0), ros::Duration(timeout)));
-  } catch (const tf2::TransformException& e) {
-    refusal = "cannot transform from '" + frame_id + "' to '" + map_frame + "': " + e.what();
+    return latestTransform(tf_buffer, map_frame, frame_id, timeout);
+  } catch (const TransformUnavailable& e) {
+    refusal = e.what();
     return std::nullopt;
   }
 }

@@ -1,0 +1,22 @@
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include <tf2_ros/buffer.h>
+#include <Eigen/Geometry>
+
+namespace mvog_ros {
+
+/// A transform that a request or a part of the server needs and tf does not have.
+class TransformUnavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The latest transform from `frame` into `map_frame`, waiting up to `timeout` s for it. Throws
+/// TransformUnavailable: "cannot transform from 'FRAME' to 'MAP_FRAME': why".
+Eigen::Isometry3d latestTransform(const tf2_ros::Buffer& tf_buffer, const std::string& map_frame,
+                                  const std::string& frame, double timeout);
+
+}  // namespace mvog_ros
