@@ -1,5 +1,5 @@
 // Google Benchmark of the ROS layer's conversions of a depth camera's frame (see
-// docs/depth-benchmark-figures.md): the depth-image path (Image 16UC1 or 32FC1 with its camera
+// BENCHMARKS.md section 11): the depth-image path (Image 16UC1 or 32FC1 with its camera
 // info to readings) against the cloud path (the image back-projected into an organised
 // PointCloud2, as depth_image_proc does beside the driver, then the cloud to readings), and what
 // each message costs to serialise and deserialise (once per connection). One 640 x 480 frame of a
