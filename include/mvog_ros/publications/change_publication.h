@@ -43,9 +43,10 @@ class ChangePublication {
   void stop();
   /// Under mutex_ and the map's lock.
   void restartIfReplacedLocked();
-  /// tilesChangedSince what the publication shows: nothing if the map cannot tell which tiles
-  /// it removed, as after a mirror's full update (under mutex_ and the map's lock).
-  std::optional<std::vector<mvog::TileIndex>> changedSincePublished() const;
+  /// Publishes what changed since the last publication, if anything (under mutex_ and the map's
+  /// lock): what the timer does, and what must happen before a new subscriber is sent a state
+  /// the others have not been sent yet.
+  void publishChangesLocked();
 
   /// Clears what was published of the previous map (under mutex_ and the map's lock).
   virtual void clearPublished() = 0;

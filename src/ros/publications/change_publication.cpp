@@ -43,16 +43,17 @@ void ChangePublication::restartIfReplacedLocked() {
   published_ = {map_.generation, 0};
 }
 
-std::optional<std::vector<mvog::TileIndex>> ChangePublication::changedSincePublished() const {
-  return tilesChangedSince(map_.map, published_.revision);
-}
-
 void ChangePublication::publishChanges(const ros::TimerEvent&) {
   std::lock_guard<std::mutex> publication_lock(mutex_);
   std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
+  publishChangesLocked();
+}
+
+void ChangePublication::publishChangesLocked() {
   restartIfReplacedLocked();
   if (map_.version() == published_) return;
-  std::optional<std::vector<mvog::TileIndex>> changed = changedSincePublished();
+  std::optional<std::vector<mvog::TileIndex>> changed =
+      tilesChangedSince(map_.map, published_.revision);
   if (!changed) {  // the map no longer knows which tiles it removed: show it afresh
     clearPublished();
     changed = map_.map.tilesModifiedSince(0);

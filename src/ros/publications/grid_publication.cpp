@@ -108,15 +108,12 @@ void GridPublication::publishTiles(const std::vector<mvog::TileIndex>& changed) 
 void GridPublication::send(const ros::SingleSubscriberPublisher& subscriber, std::size_t layer) {
   std::lock_guard<std::mutex> publication_lock(mutex_);
   std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
-  restartIfReplacedLocked();
-  Layer& sent = layers_[layer];
-  const std::optional<std::vector<mvog::TileIndex>> changed = changedSincePublished();
-  if (!changed) sent.grid.clear();  // laid out afresh by the update
-  bool relaid_out = false;
-  if (!update(sent, changed.value_or(std::vector<mvog::TileIndex>{}), relaid_out) ||
-      sent.grid.cells().empty()) {  // too large, or nothing mapped yet
-    return;
-  }
+  // The grids are brought up to the map for every subscriber first: were they updated for the
+  // new one alone, the next publication would find nothing changed there, and the others would
+  // never be sent those cells.
+  publishChangesLocked();
+  const Layer& sent = layers_[layer];
+  if (sent.grid.cells().empty()) return;  // nothing mapped yet, or too large from the start
   nav_msgs::OccupancyGrid grid = sent.grid.grid();
   grid.header.frame_id = frame_id_;
   grid.header.stamp = ros::Time::now();
