@@ -183,9 +183,7 @@ void Map::setCellVolumes(const std::vector<CellAssignment>& cells) {
         std::fabs(static_cast<double>(c.y)) > max_cell) {
       refuse(" lies beyond max_coordinate");
     }
-    if (!seen.insert((std::uint64_t{static_cast<std::uint32_t>(c.x)} << 32) |
-                     static_cast<std::uint32_t>(c.y))
-             .second) {
+    if (!seen.insert(detail::cellKey(c)).second) {
       refuse(" is given twice");
     }
     const CellVolumes& v = assignment.volumes;

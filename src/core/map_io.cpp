@@ -124,9 +124,7 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
         detail::readCell(reader, volume_count - volumes_read, assignment.cell, assignment.volumes);
     if (!problem.empty()) fail(problem);
     const CellIndex& cell = assignment.cell;
-    const std::uint64_t key = (std::uint64_t{static_cast<std::uint32_t>(cell.x)} << 32) |
-                              static_cast<std::uint32_t>(cell.y);
-    if (!seen.insert(key).second) {
+    if (!seen.insert(detail::cellKey(cell)).second) {
       fail(detail::cellName(cell).append(" appears twice"));
     }
     volumes_read += assignment.volumes.positive.size() + assignment.volumes.negative.size();

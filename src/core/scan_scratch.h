@@ -178,6 +178,10 @@ std::size_t joinInterval(std::vector<ScanInterval>& list, float bottom, float to
                          float join_gap);
 /// Joins the intervals of a list sorted by bottom that come within `join_gap`, in place.
 void joinSorted(std::vector<ScanInterval>& intervals, float join_gap);
+/// Splits a scan's readings among `chunks` threads (see scan_update.cpp).
+void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
+                           const InsertionConfig& insertion, std::size_t chunks,
+                           std::vector<std::uint8_t>& chunk_of);
 /// The gap under which one scan's intervals join (see ScanInterval).
 inline float joinGapOf(const ModelRules& rules) {
   return rules.mass_counting == MassCounting::kPerScan ? kMaxMergeGap : 0.0f;
@@ -190,6 +194,8 @@ struct ScanUpdate::Impl {
   InsertionResult result;
   /// One per chunk of readings (one per thread).
   std::vector<detail::ScanScratch> scratches;
+  /// With several threads: the scratch of each reading of the scan (splitReadingsBySector).
+  std::vector<std::uint8_t> chunk_of_reading;
   std::unique_ptr<detail::ThreadPool> pool;
 
   /// Threads for `insertion_threads`, started once.

@@ -152,6 +152,14 @@ void ScanScratch::appendFree(const ScratchTile& tile, unsigned local,
 
 namespace {
 
+/// How far from the sensor a reading of `kind` may free space (m): a hit up to max_range, a
+/// reading without a return up to out_of_range_free_length too (ModelRules).
+double freeLengthOf(ReadingKind kind, const MapConfig& map_config, const InsertionConfig& config) {
+  return kind == ReadingKind::kObstacle
+             ? config.max_range
+             : std::min(config.max_range, map_config.rules.out_of_range_free_length);
+}
+
 /// Checks one reading and counts it in `result`; on acceptance sets the ray's end (truncated to
 /// max_range) and whether it ends in an obstacle.
 bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, ReadingKind kind,
@@ -180,9 +188,7 @@ bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, Re
     ++result.ignored_out_of_range;
     return false;
   }
-  const double free_length =
-      is_obstacle ? config.max_range
-                  : std::min(config.max_range, map_config.rules.out_of_range_free_length);
+  const double free_length = freeLengthOf(kind, map_config, config);
   ray_end = length > free_length ? Eigen::Vector3d(origin + ray * (free_length / length)) : end;
   if (obstacle) {
     ++result.obstacle_readings;
@@ -220,12 +226,11 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
           });
 }
 
-/// Readings [first, last) of `scan` (its hits, then its out-of-range readings), checked,
-/// counted and rasterised into `writer`.
-template <class Writer>
-void rasterizeReadings(const Scan& scan, std::size_t first, std::size_t last,
-                       const MapConfig& map_config, const InsertionConfig& insertion,
-                       Writer& writer, InsertionResult& result) {
+/// The readings of `scan` (its hits, then its out-of-range readings) that `mine(k)` gives to
+/// this chunk, checked, counted and rasterised into `writer`.
+template <class Writer, class Mine>
+void rasterizeReadings(const Scan& scan, const Mine& mine, const MapConfig& map_config,
+                       const InsertionConfig& insertion, Writer& writer, InsertionResult& result) {
   const double s = 1.0 / map_config.resolution;
   const Eigen::Vector3d start = scan.origin * s;
   const std::size_t num_hits = scan.hits.size();
@@ -238,19 +243,86 @@ void rasterizeReadings(const Scan& scan, std::size_t first, std::size_t last,
     }
   };
   const auto began = std::chrono::steady_clock::now();
-  for (std::size_t k = first; k < std::min(last, num_hits); ++k) {
-    add(scan.hits[k], ReadingKind::kObstacle);
+  for (std::size_t k = 0; k < num_hits; ++k) {
+    if (mine(k)) add(scan.hits[k], ReadingKind::kObstacle);
   }
   const auto hits_done = std::chrono::steady_clock::now();
-  for (std::size_t k = std::max(first, num_hits); k < last; ++k) {
-    add(scan.out_of_range[k - num_hits], ReadingKind::kOutOfRange);
+  for (std::size_t k = 0; k < scan.out_of_range.size(); ++k) {
+    if (mine(num_hits + k)) add(scan.out_of_range[k], ReadingKind::kOutOfRange);
   }
   result.obstacle_seconds = std::chrono::duration<double>(hits_done - began).count();
   result.out_of_range_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - hits_done).count();
 }
 
+/// Sectors of directions around a scan's origin, for splitting its readings among threads.
+constexpr std::size_t kSectors = 1024;
+
+/// The direction of (dx, dy) as a number in [0, 4) that grows with the angle (a "diamond
+/// angle": atan2's order without its cost).
+float pseudoAngle(double dx, double dy) {
+  const double p = dx / (std::fabs(dx) + std::fabs(dy));
+  return static_cast<float>(dy >= 0.0 ? 1.0 - p : 3.0 + p);
+}
+
 }  // namespace
+
+/// Gives each reading of `scan` to one of `chunks` threads (chunk_of[k] for reading k: hits, then
+/// out-of-range readings) by the direction of its ray around the scan's origin, each chunk a run
+/// of neighbouring sectors holding about the same number of cell visits. The readings of a
+/// chunk then reach columns that the other chunks mostly do not, so few columns need their
+/// parts joined when the scan is applied (which the map's result does not depend on: it is the
+/// same for any split, ScanInterval).
+void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
+                           const InsertionConfig& insertion, std::size_t chunks,
+                           std::vector<std::uint8_t>& chunk_of) {
+  const std::size_t num_hits = scan.hits.size();
+  const std::size_t num_readings = num_hits + scan.out_of_range.size();
+  const double s = 1.0 / map_config.resolution;
+  std::vector<std::uint16_t> sector_of(num_readings, 0);
+  std::vector<double> cells_in(kSectors, 0.0);
+  for (std::size_t k = 0; k < num_readings; ++k) {
+    const bool is_hit = k < num_hits;
+    const Eigen::Vector3d ray =
+        (is_hit ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>() - scan.origin;
+    const double length = ray.norm();
+    // A reading that will be refused (not finite, at the origin) costs about one cell.
+    if (!std::isfinite(length) || !scan.origin.allFinite() || length == 0.0) {
+      cells_in[0] += 1.0;
+      continue;
+    }
+    const double free_length = freeLengthOf(
+        is_hit ? ReadingKind::kObstacle : ReadingKind::kOutOfRange, map_config, insertion);
+    const double walked = std::min(1.0, free_length / length) * s;
+    const auto sector = static_cast<std::uint16_t>(
+        std::min<double>(kSectors - 1, pseudoAngle(ray.x(), ray.y()) * (kSectors / 4.0)));
+    sector_of[k] = sector;
+    // The walk takes |di| + |dj| steps: the cells the reading costs.
+    cells_in[sector] += (std::fabs(ray.x()) + std::fabs(ray.y())) * walked + 1.0;
+  }
+  // Around the circle from the sector with the fewest cells (outside a camera's field of view,
+  // or a 360-degree sensor's emptiest direction), each chunk takes consecutive sectors until it
+  // holds its share of the cells.
+  const std::size_t first = static_cast<std::size_t>(
+      std::min_element(cells_in.begin(), cells_in.end()) - cells_in.begin());
+  double total = 0.0;
+  for (double cells : cells_in) total += cells;
+  std::vector<std::uint8_t> chunk_of_sector(kSectors);
+  double so_far = 0.0;
+  std::size_t chunk = 0;
+  for (std::size_t n = 0; n < kSectors; ++n) {
+    const std::size_t sector = (first + n) % kSectors;
+    while (chunk + 1 < chunks &&
+           so_far >= total * static_cast<double>(chunk + 1) / static_cast<double>(chunks)) {
+      ++chunk;
+    }
+    chunk_of_sector[sector] = static_cast<std::uint8_t>(chunk);
+    so_far += cells_in[sector];
+  }
+  chunk_of.resize(num_readings);
+  for (std::size_t k = 0; k < num_readings; ++k) chunk_of[k] = chunk_of_sector[sector_of[k]];
+}
+
 }  // namespace detail
 
 detail::ThreadPool* ScanUpdate::Impl::threads(std::size_t count) {
@@ -286,11 +358,15 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
   const std::size_t num_readings = num_hits + scan.out_of_range.size();
   const double s = 1.0 / map_config.resolution;
   std::vector<InsertionResult> results(num_threads);
-  // Chunk k of the readings (hits, then out-of-range readings) goes to scratch k.
+  if (num_threads > 1) {
+    detail::splitReadingsBySector(scan, map_config, insertion, num_threads, impl.chunk_of_reading);
+  }
+  // Chunk k of the readings goes to scratch k.
   auto rasterize = [&](std::size_t, std::size_t chunk) {
     detail::ScanScratch& scratch = impl.scratches[chunk];
-    const std::size_t first = num_readings * chunk / num_threads;
-    const std::size_t last = num_readings * (chunk + 1) / num_threads;
+    auto mine = [&](std::size_t k) {
+      return num_threads == 1 || impl.chunk_of_reading[k] == chunk;
+    };
     // The tiles of the chunk's rays (those it may accept) for the scratch's dense index.
     CellRange tiles = kNoCells;
     auto reach = [&](const Eigen::Vector3d& p) {
@@ -299,17 +375,19 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
       tiles.extend(CellIndex{cell.x >> detail::kTileSizeLog2, cell.y >> detail::kTileSizeLog2});
     };
     reach(scan.origin);
-    for (std::size_t k = first; k < last; ++k) {
-      reach((k < num_hits ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>());
+    for (std::size_t k = 0; k < num_readings; ++k) {
+      if (mine(k)) {
+        reach((k < num_hits ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>());
+      }
     }
     const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
     scratch.begin(detail::joinGapOf(map_config.rules), count_masses, tiles);
     if (count_masses) {
       detail::ScanScratch::Writer<true> writer(scratch);
-      detail::rasterizeReadings(scan, first, last, map_config, insertion, writer, results[chunk]);
+      detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
     } else {
       detail::ScanScratch::Writer<false> writer(scratch);
-      detail::rasterizeReadings(scan, first, last, map_config, insertion, writer, results[chunk]);
+      detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
     }
   };
   if (detail::ThreadPool* pool = impl.threads(num_threads)) {

@@ -37,6 +37,8 @@ inline std::uint64_t tileKey(std::int32_t tile_x, std::int32_t tile_y) {
 }
 inline std::int32_t tileKeyX(std::uint64_t key) { return static_cast<std::int32_t>(key >> 32); }
 inline std::int32_t tileKeyY(std::uint64_t key) { return static_cast<std::int32_t>(key); }
+/// A cell (x, y) as one hash key, packed as a tile's.
+inline std::uint64_t cellKey(const CellIndex& c) { return tileKey(c.x, c.y); }
 inline std::uint64_t tileKeyOf(const CellIndex& c) {
   return tileKey(c.x >> kTileSizeLog2, c.y >> kTileSizeLog2);  // arithmetic shifts floor
 }

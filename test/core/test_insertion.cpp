@@ -541,6 +541,61 @@ TEST(Insertion, ThreadsBuildTheSameMap) {
   }
 }
 
+TEST(Insertion, ThreadsSplittingACamerasFieldOfViewBuildTheSameMap) {
+  // Threads share a scan's readings by their direction around its origin. A camera looking along
+  // +x (where the directions' order wraps round), a fan seen almost edge-on, and readings that
+  // are refused (not finite, at the origin, beyond max_coordinate), each scan with 1 to 4
+  // threads: the same volumes bit for bit, every reading counted once.
+  MapConfig map_config;
+  map_config.resolution = 0.1;
+  map_config.max_coordinate = 50.0;
+  Scan camera;
+  camera.origin = {0.25, -0.125, 1.0};  // exact in float: a hit there has length 0
+  for (int row = -20; row <= 20; ++row) {
+    for (int column = -30; column <= 30; ++column) {
+      const double depth = 2.0 + 0.05 * ((row * 7 + column * 3) % 11);
+      const Eigen::Vector3d ray(depth, depth * column / 50.0, depth * row / 60.0);
+      const Eigen::Vector3f end = (camera.origin + ray).cast<float>();
+      ((row + column) % 9 == 0 ? camera.out_of_range : camera.hits).push_back(end);
+    }
+  }
+  camera.hits.push_back(camera.origin.cast<float>());
+  camera.hits.push_back({std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f});
+  camera.hits.push_back({80.0f, 0.0f, 0.0f});
+  Scan edge_on;
+  edge_on.origin = {-1.0, 2.0, 0.5};
+  for (int k = 0; k < 400; ++k) {
+    edge_on.hits.push_back({static_cast<float>(-1.0 + 6.0 * k / 400.0), 2.05f, 0.5f});
+  }
+  for (const ModelRules& rules : {ModelRules::paper(), ModelRules{}}) {
+    SCOPED_TRACE(describe(rules));
+    map_config.rules = rules;
+    std::vector<std::vector<test::VolumeRecord>> maps;
+    std::vector<InsertionResult> results;
+    for (int threads = 1; threads <= 4; ++threads) {
+      Map map(map_config);
+      InsertionConfig config;
+      config.insertion_threads = threads;
+      InsertionResult result = map.insertScan(camera, config);
+      result += map.insertScan(edge_on, config);
+      maps.push_back(allVolumes(map));
+      results.push_back(result);
+    }
+    EXPECT_EQ(results[0].rejected_non_finite, 1u);
+    EXPECT_EQ(results[0].rejected_too_close, 1u);
+    EXPECT_EQ(results[0].rejected_out_of_bounds, 1u);
+    for (int threads = 2; threads <= 4; ++threads) {
+      EXPECT_TRUE(test::sameVolumes(maps[threads - 1], maps[0])) << threads << " threads";
+      const InsertionResult& r = results[threads - 1];
+      EXPECT_EQ(r.obstacle_readings, results[0].obstacle_readings) << threads << " threads";
+      EXPECT_EQ(r.out_of_range_readings, results[0].out_of_range_readings);
+      EXPECT_EQ(r.rejected_non_finite, results[0].rejected_non_finite);
+      EXPECT_EQ(r.rejected_too_close, results[0].rejected_too_close);
+      EXPECT_EQ(r.rejected_out_of_bounds, results[0].rejected_out_of_bounds);
+    }
+  }
+}
+
 TEST(Insertion, AReadingIsTheScanOfOneReading) {
   for (const ModelRules& rules : everyRuleSet()) {
     SCOPED_TRACE(describe(rules));

@@ -91,14 +91,9 @@ class Node:
 
     def snapshot(self):
         """The bytes of a save of the map now."""
-        name = "snapshot_%s.mvog" % self.ns.strip("/").replace("/", "_")
-        response = self.call("save_map", MapFile, path=name)
-        assert response.success, response.message
-        path = os.path.join(self.directory, name)
-        with open(path, "rb") as f:
-            data = f.read()
-        os.unlink(path)
-        return data
+        return rel.saved_map_bytes(lambda name: self.call("save_map", MapFile, path=name),
+                                   self.directory,
+                                   "snapshot_%s.mvog" % self.ns.strip("/").replace("/", "_"))
 
     def states(self, points):
         response = self.call("get_occupancy", GetOccupancy, frame_id="",

@@ -158,6 +158,17 @@ def fnv1a64(data):
     return h
 
 
+def saved_map_bytes(save, directory, name):
+    """The bytes of the map saved by save(name) into `directory` (the file is removed)."""
+    response = save(name)
+    assert response.success, response.message
+    path = os.path.join(directory, name)
+    with open(path, "rb") as f:
+        data = f.read()
+    os.unlink(path)
+    return data
+
+
 class Server:
     """One mvog_node started by the test: /NAME, reading /NAME/scan_in, /NAME/cloud_in and the
     depth images of /NAME/depth/image with /NAME/depth/camera_info."""
@@ -245,14 +256,7 @@ class Server:
     def snapshot(self):
         """The current map, as the bytes of a save."""
         self.snapshots += 1
-        name = "snapshot_%d.mvog" % self.snapshots
-        response = self.save(name)
-        assert response.success, response.message
-        path = os.path.join(self.directory, name)
-        with open(path, "rb") as f:
-            data = f.read()
-        os.unlink(path)
-        return data
+        return saved_map_bytes(self.save, self.directory, "snapshot_%d.mvog" % self.snapshots)
 
     def occupancy(self, points, frame_id=""):
         from geometry_msgs.msg import Point
