@@ -103,6 +103,29 @@ void TileBlock::Builder::add(unsigned local, const ColumnRef& column, double mas
   }
 }
 
+void TileBlock::Builder::addUnchanged(const TileBlock& tile, unsigned first, unsigned end) {
+  if (tile.empty() || first >= end) return;
+  const Header& header = *tile.block_;
+  // The rank of the first cell at or after `first`: the held cells before it.
+  unsigned r = first == kCellsPerTile ? header.num_cells : tile.rank(first);
+  const unsigned first_rank = r;
+  const auto shift = static_cast<std::int64_t>(volumes_.size()) -
+                     static_cast<std::int64_t>(r < header.num_cells ? tile.start(r) : 0);
+  for (unsigned word = first >> 6; word < kCellsPerTile / 64 && 64 * word < end; ++word) {
+    std::uint64_t bits = header.occupied[word];
+    if (64 * word < first) bits &= ~std::uint64_t{0} << (first & 63);
+    if (end < 64 * (word + 1)) bits &= (std::uint64_t{1} << (end & 63)) - 1;
+    for (; bits != 0; bits &= bits - 1, ++r) {
+      locals_.push_back(static_cast<std::uint16_t>(64 * word + lowestBit(bits)));
+      starts_.push_back(static_cast<std::uint32_t>(tile.start(r) + shift));
+      num_positive_.push_back(tile.positiveCount(r));
+    }
+  }
+  if (r == first_rank) return;
+  const Volume* from = tile.volumes() + tile.start(first_rank);
+  volumes_.insert(volumes_.end(), from, tile.volumes() + tile.start(r));
+}
+
 void TileBlock::Builder::add(unsigned local, const std::vector<Volume>& positive,
                              const std::vector<Volume>& negative) {
   locals_.push_back(static_cast<std::uint16_t>(local));
@@ -185,19 +208,17 @@ void TileBlock::Rewrite::set(unsigned local, const std::vector<Volume>& positive
 
 TileBlock TileBlock::Rewrite::apply(const TileBlock& tile, std::int32_t exponent,
                                     std::uint64_t modified_revision) {
-  auto cell = cells_.begin();
-  for (unsigned local = 0; local < kCellsPerTile; ++local) {
-    if (cell != cells_.end() && cell->local == local) {
-      if (cell->num_positive + cell->num_negative > 0) {
-        const Volume* v = volumes_.data() + cell->start;
-        builder_.add(local, {v, cell->num_positive, v + cell->num_positive, cell->num_negative},
-                     1.0);
-      }
-      ++cell;
-    } else if (tile.holds(local)) {
-      builder_.add(local, tile.column(local), 1.0);
+  unsigned next_local = 0;
+  for (const Cell& cell : cells_) {
+    builder_.addUnchanged(tile, next_local, cell.local);
+    if (cell.num_positive + cell.num_negative > 0) {
+      const Volume* v = volumes_.data() + cell.start;
+      builder_.add(cell.local, {v, cell.num_positive, v + cell.num_positive, cell.num_negative},
+                   1.0);
     }
+    next_local = cell.local + 1;
   }
+  builder_.addUnchanged(tile, next_local, kCellsPerTile);
   return builder_.finish(exponent, modified_revision);
 }
 

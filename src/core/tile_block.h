@@ -129,6 +129,9 @@ class TileBlock {
     void add(unsigned local, const ColumnRef& column, double mass_scale);
     void add(unsigned local, const std::vector<Volume>& positive,
              const std::vector<Volume>& negative);
+    /// Appends the cells of `tile` with local indices in [first, end), as they are: their
+    /// volumes copied in one run.
+    void addUnchanged(const TileBlock& tile, unsigned first, unsigned end);
     /// The tile of the cells added (empty if none), which the builder then forgets.
     TileBlock finish(std::int32_t exponent, std::uint64_t modified_revision);
 
