@@ -178,10 +178,17 @@ std::size_t joinInterval(std::vector<ScanInterval>& list, float bottom, float to
                          float join_gap);
 /// Joins the intervals of a list sorted by bottom that come within `join_gap`, in place.
 void joinSorted(std::vector<ScanInterval>& intervals, float join_gap);
+/// Which thread's scratch each reading of a scan goes to, and what decided it: kept from scan
+/// to scan.
+struct ReadingSplit {
+  std::vector<std::uint8_t> chunk_of_reading;    ///< by reading: hits, then out-of-range ones
+  std::vector<std::uint16_t> sector_of_reading;  ///< the direction of its ray
+  std::vector<double> cells_in_sector;           ///< the cell visits of the sector's readings
+};
 /// Splits a scan's readings among `chunks` threads (see scan_update.cpp).
 void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
                            const InsertionConfig& insertion, std::size_t chunks,
-                           std::vector<std::uint8_t>& chunk_of);
+                           ReadingSplit& split);
 /// The gap under which one scan's intervals join (see ScanInterval).
 inline float joinGapOf(const ModelRules& rules) {
   return rules.mass_counting == MassCounting::kPerScan ? kMaxMergeGap : 0.0f;
@@ -195,7 +202,7 @@ struct ScanUpdate::Impl {
   /// One per chunk of readings (one per thread).
   std::vector<detail::ScanScratch> scratches;
   /// With several threads: the scratch of each reading of the scan (splitReadingsBySector).
-  std::vector<std::uint8_t> chunk_of_reading;
+  detail::ReadingSplit split;
   std::unique_ptr<detail::ThreadPool> pool;
 
   /// Threads for `insertion_threads`, started once.

@@ -275,30 +275,42 @@ float pseudoAngle(double dx, double dy) {
 /// same for any split, ScanInterval).
 void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
                            const InsertionConfig& insertion, std::size_t chunks,
-                           std::vector<std::uint8_t>& chunk_of) {
+                           ReadingSplit& split) {
   const std::size_t num_hits = scan.hits.size();
   const std::size_t num_readings = num_hits + scan.out_of_range.size();
   const double s = 1.0 / map_config.resolution;
-  std::vector<std::uint16_t> sector_of(num_readings, 0);
-  std::vector<double> cells_in(kSectors, 0.0);
+  std::vector<std::uint16_t>& sector_of = split.sector_of_reading;
+  std::vector<double>& cells_in = split.cells_in_sector;
+  sector_of.assign(num_readings, 0);
+  cells_in.assign(kSectors, 0.0);
+  const bool origin_accepted =
+      scan.origin.allFinite() && scan.origin.cwiseAbs().maxCoeff() <= map_config.max_coordinate;
   for (std::size_t k = 0; k < num_readings; ++k) {
     const bool is_hit = k < num_hits;
-    const Eigen::Vector3d ray =
-        (is_hit ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>() - scan.origin;
+    const Eigen::Vector3d end =
+        (is_hit ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>();
+    const Eigen::Vector3d ray = end - scan.origin;
     const double length = ray.norm();
-    // A reading that will be refused (not finite, at the origin) costs about one cell.
-    if (!std::isfinite(length) || !scan.origin.allFinite() || length == 0.0) {
+    // A reading that will be refused (acceptReading: not finite, beyond max_coordinate, at the
+    // origin) costs about one cell.
+    if (!origin_accepted || !std::isfinite(length) ||
+        end.cwiseAbs().maxCoeff() > map_config.max_coordinate || length == 0.0) {
       cells_in[0] += 1.0;
       continue;
     }
     const double free_length = freeLengthOf(
         is_hit ? ReadingKind::kObstacle : ReadingKind::kOutOfRange, map_config, insertion);
-    const double walked = std::min(1.0, free_length / length) * s;
+    // The walk takes |di| + |dj| steps over the part of the ray it frees: the cells it costs.
+    const double walk_cells =
+        (std::fabs(ray.x()) + std::fabs(ray.y())) * std::min(1.0, free_length / length) * s + 1.0;
+    // A vertical ray has no direction in xy: it crosses one column, in sector 0.
+    const bool vertical = ray.x() == 0.0 && ray.y() == 0.0;
     const auto sector = static_cast<std::uint16_t>(
-        std::min<double>(kSectors - 1, pseudoAngle(ray.x(), ray.y()) * (kSectors / 4.0)));
+        vertical
+            ? 0.0
+            : std::min<double>(kSectors - 1, pseudoAngle(ray.x(), ray.y()) * (kSectors / 4.0)));
     sector_of[k] = sector;
-    // The walk takes |di| + |dj| steps: the cells the reading costs.
-    cells_in[sector] += (std::fabs(ray.x()) + std::fabs(ray.y())) * walked + 1.0;
+    cells_in[sector] += walk_cells;
   }
   // Around the circle from the sector with the fewest cells (outside a camera's field of view,
   // or a 360-degree sensor's emptiest direction), each chunk takes consecutive sectors until it
@@ -307,7 +319,7 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
       std::min_element(cells_in.begin(), cells_in.end()) - cells_in.begin());
   double total = 0.0;
   for (double cells : cells_in) total += cells;
-  std::vector<std::uint8_t> chunk_of_sector(kSectors);
+  std::uint8_t chunk_of_sector[kSectors];
   double so_far = 0.0;
   std::size_t chunk = 0;
   for (std::size_t n = 0; n < kSectors; ++n) {
@@ -319,8 +331,10 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
     chunk_of_sector[sector] = static_cast<std::uint8_t>(chunk);
     so_far += cells_in[sector];
   }
-  chunk_of.resize(num_readings);
-  for (std::size_t k = 0; k < num_readings; ++k) chunk_of[k] = chunk_of_sector[sector_of[k]];
+  split.chunk_of_reading.resize(num_readings);
+  for (std::size_t k = 0; k < num_readings; ++k) {
+    split.chunk_of_reading[k] = chunk_of_sector[sector_of[k]];
+  }
 }
 
 }  // namespace detail
@@ -359,13 +373,13 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
   const double s = 1.0 / map_config.resolution;
   std::vector<InsertionResult> results(num_threads);
   if (num_threads > 1) {
-    detail::splitReadingsBySector(scan, map_config, insertion, num_threads, impl.chunk_of_reading);
+    detail::splitReadingsBySector(scan, map_config, insertion, num_threads, impl.split);
   }
-  // Chunk k of the readings goes to scratch k.
+  // The readings of chunk k (split.chunk_of_reading) go to scratch k.
   auto rasterize = [&](std::size_t, std::size_t chunk) {
     detail::ScanScratch& scratch = impl.scratches[chunk];
     auto mine = [&](std::size_t k) {
-      return num_threads == 1 || impl.chunk_of_reading[k] == chunk;
+      return num_threads == 1 || impl.split.chunk_of_reading[k] == chunk;
     };
     // The tiles of the chunk's rays (those it may accept) for the scratch's dense index.
     CellRange tiles = kNoCells;

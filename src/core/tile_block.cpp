@@ -1,6 +1,7 @@
 #include "tile_block.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -106,8 +107,9 @@ void TileBlock::Builder::add(unsigned local, const ColumnRef& column, double mas
 void TileBlock::Builder::addUnchanged(const TileBlock& tile, unsigned first, unsigned end) {
   if (tile.empty() || first >= end) return;
   const Header& header = *tile.block_;
-  // The rank of the first cell at or after `first`: the held cells before it.
-  unsigned r = first == kCellsPerTile ? header.num_cells : tile.rank(first);
+  // The rank of the first cell at or after `first` (< end <= kCellsPerTile): the held cells
+  // before it.
+  unsigned r = tile.rank(first);
   const unsigned first_rank = r;
   const auto shift = static_cast<std::int64_t>(volumes_.size()) -
                      static_cast<std::int64_t>(r < header.num_cells ? tile.start(r) : 0);
@@ -200,6 +202,7 @@ void TileBlock::Rewrite::clear() {
 
 void TileBlock::Rewrite::set(unsigned local, const std::vector<Volume>& positive,
                              const std::vector<Volume>& negative) {
+  assert(cells_.empty() || cells_.back().local < local);  // apply() copies the cells between
   cells_.push_back({local, volumes_.size(), static_cast<std::uint32_t>(positive.size()),
                     static_cast<std::uint32_t>(negative.size())});
   volumes_.insert(volumes_.end(), positive.begin(), positive.end());

@@ -543,9 +543,9 @@ TEST(Insertion, ThreadsBuildTheSameMap) {
 
 TEST(Insertion, ThreadsSplittingACamerasFieldOfViewBuildTheSameMap) {
   // Threads share a scan's readings by their direction around its origin. A camera looking along
-  // +x (where the directions' order wraps round), a fan seen almost edge-on, and readings that
-  // are refused (not finite, at the origin, beyond max_coordinate), each scan with 1 to 4
-  // threads: the same volumes bit for bit, every reading counted once.
+  // +x (where the directions' order wraps round), a fan seen almost edge-on, a vertical ray and
+  // readings that are refused (not finite, at the origin, beyond max_coordinate), each scan with
+  // 1 to 4 threads: the same volumes bit for bit, every reading counted once.
   MapConfig map_config;
   map_config.resolution = 0.1;
   map_config.max_coordinate = 50.0;
@@ -559,6 +559,7 @@ TEST(Insertion, ThreadsSplittingACamerasFieldOfViewBuildTheSameMap) {
       ((row + column) % 9 == 0 ? camera.out_of_range : camera.hits).push_back(end);
     }
   }
+  camera.hits.push_back({0.25f, -0.125f, 0.25f});  // straight down: no direction in xy
   camera.hits.push_back(camera.origin.cast<float>());
   camera.hits.push_back({std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f});
   camera.hits.push_back({80.0f, 0.0f, 0.0f});
@@ -567,31 +568,46 @@ TEST(Insertion, ThreadsSplittingACamerasFieldOfViewBuildTheSameMap) {
   for (int k = 0; k < 400; ++k) {
     edge_on.hits.push_back({static_cast<float>(-1.0 + 6.0 * k / 400.0), 2.05f, 0.5f});
   }
-  for (const ModelRules& rules : {ModelRules::paper(), ModelRules{}}) {
-    SCOPED_TRACE(describe(rules));
-    map_config.rules = rules;
-    std::vector<std::vector<test::VolumeRecord>> maps;
-    std::vector<InsertionResult> results;
-    for (int threads = 1; threads <= 4; ++threads) {
-      Map map(map_config);
-      InsertionConfig config;
-      config.insertion_threads = threads;
-      InsertionResult result = map.insertScan(camera, config);
-      result += map.insertScan(edge_on, config);
-      maps.push_back(allVolumes(map));
-      results.push_back(result);
-    }
-    EXPECT_EQ(results[0].rejected_non_finite, 1u);
-    EXPECT_EQ(results[0].rejected_too_close, 1u);
-    EXPECT_EQ(results[0].rejected_out_of_bounds, 1u);
-    for (int threads = 2; threads <= 4; ++threads) {
-      EXPECT_TRUE(test::sameVolumes(maps[threads - 1], maps[0])) << threads << " threads";
-      const InsertionResult& r = results[threads - 1];
-      EXPECT_EQ(r.obstacle_readings, results[0].obstacle_readings) << threads << " threads";
-      EXPECT_EQ(r.out_of_range_readings, results[0].out_of_range_readings);
-      EXPECT_EQ(r.rejected_non_finite, results[0].rejected_non_finite);
-      EXPECT_EQ(r.rejected_too_close, results[0].rejected_too_close);
-      EXPECT_EQ(r.rejected_out_of_bounds, results[0].rejected_out_of_bounds);
+  const std::size_t num_readings = camera.hits.size() + camera.out_of_range.size() +
+                                   edge_on.hits.size() + edge_on.out_of_range.size();
+  InsertionConfig truncating;
+  truncating.max_range = 2.2;
+  InsertionConfig ignoring_out_of_range;
+  ignoring_out_of_range.insert_out_of_range = false;
+  for (const InsertionConfig& insertion : {InsertionConfig{}, truncating, ignoring_out_of_range}) {
+    for (const ModelRules& rules : {ModelRules::paper(), ModelRules{}}) {
+      SCOPED_TRACE(describe(rules));
+      SCOPED_TRACE("max_range " + std::to_string(insertion.max_range) + ", insert_out_of_range " +
+                   std::to_string(insertion.insert_out_of_range));
+      map_config.rules = rules;
+      std::vector<std::vector<test::VolumeRecord>> maps;
+      std::vector<InsertionResult> results;
+      for (int threads = 1; threads <= 4; ++threads) {
+        Map map(map_config);
+        InsertionConfig config = insertion;
+        config.insertion_threads = threads;
+        InsertionResult result = map.insertScan(camera, config);
+        result += map.insertScan(edge_on, config);
+        maps.push_back(allVolumes(map));
+        results.push_back(result);
+      }
+      EXPECT_EQ(results[0].rejected_non_finite, 1u);
+      EXPECT_EQ(results[0].rejected_too_close, 1u);
+      EXPECT_EQ(results[0].rejected_out_of_bounds, 1u);
+      EXPECT_EQ(results[0].truncated_to_max_range > 0, insertion.max_range < 10.0);
+      EXPECT_EQ(results[0].ignored_out_of_range > 0, !insertion.insert_out_of_range);
+      for (int threads = 1; threads <= 4; ++threads) {
+        const InsertionResult& r = results[threads - 1];
+        EXPECT_EQ(r.inserted() + r.rejected(), num_readings) << threads << " threads";
+        EXPECT_TRUE(test::sameVolumes(maps[threads - 1], maps[0])) << threads << " threads";
+        EXPECT_EQ(r.obstacle_readings, results[0].obstacle_readings) << threads << " threads";
+        EXPECT_EQ(r.out_of_range_readings, results[0].out_of_range_readings);
+        EXPECT_EQ(r.truncated_to_max_range, results[0].truncated_to_max_range);
+        EXPECT_EQ(r.rejected_non_finite, results[0].rejected_non_finite);
+        EXPECT_EQ(r.rejected_too_close, results[0].rejected_too_close);
+        EXPECT_EQ(r.rejected_out_of_bounds, results[0].rejected_out_of_bounds);
+        EXPECT_EQ(r.ignored_out_of_range, results[0].ignored_out_of_range);
+      }
     }
   }
 }
@@ -660,6 +676,43 @@ TEST(Insertion, EveryRuleSetEqualsThePlainReference) {
       reference.insertScan(scan);
       ASSERT_TRUE(test::sameAsReference(map, reference));
     }
+    EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+  }
+}
+
+TEST(Insertion, ATileRewrittenForSomeCellsKeepsItsOtherCells) {
+  // A tile is rebuilt when some of its lists change length; its other cells are copied in runs.
+  // Cells at the ends of the words of a tile's bitmap (local indices 0, 63, 64, 127, 128, 191,
+  // 192, 255 of the 16 x 16 cells), then some of them changed, a new cell between them, and a
+  // cell of 300 positive volumes (a tile stored with wide counts): against the plain reference
+  // after every reading.
+  const std::vector<std::pair<int, int>> word_ends = {{0, 0}, {15, 3},  {0, 4},  {15, 7},
+                                                      {0, 8}, {15, 11}, {0, 12}, {15, 15}};
+  for (const ModelRules& rules : {ModelRules::paper(), ModelRules{}}) {
+    SCOPED_TRACE(describe(rules));
+    MapConfig map_config;
+    map_config.resolution = 1.0;
+    map_config.rules = rules;
+    Map map(map_config);
+    test::ReferenceModel reference(map_config);
+    // A vertical reading in cell (x, y) from height `from` down (or up) to a hit at `to`.
+    auto vertical = [&](int x, int y, double from, double to) {
+      Scan scan;
+      scan.origin = {x + 0.5, y + 0.5, from};
+      scan.hits.push_back(
+          {static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, static_cast<float>(to)});
+      map.insertScan(scan);
+      reference.insertScan(scan);
+      return test::sameAsReference(map, reference);
+    };
+    for (const auto& [x, y] : word_ends) ASSERT_TRUE(vertical(x, y, 0.5, 5.5));
+    for (const auto& [x, y] : {word_ends[1], word_ends[2], word_ends[5], word_ends[6]}) {
+      ASSERT_TRUE(vertical(x, y, 20.5, 30.5));  // a second positive and negative volume
+    }
+    ASSERT_TRUE(vertical(4, 6, 0.5, 2.5));  // local 100: a new cell amid the others
+    for (int k = 0; k < 300; ++k) ASSERT_TRUE(vertical(7, 9, 1000.5, 40.0 + 3.0 * k));
+    EXPECT_EQ(map.cellVolumes({7, 9}).positive.size(), 300u);
+    for (const auto& [x, y] : word_ends) ASSERT_TRUE(vertical(x, y, 60.5, 70.5));
     EXPECT_TRUE(test::mapSatisfiesConstraints(map));
   }
 }
