@@ -61,11 +61,14 @@ class MultiRobot(data.DataTestCase):
         for ns in ROBOTS + [WHOLE]:
             rospy.Subscriber(ns + "/statistics", MapStatistics, cls._on_statistics,
                              callback_args=ns)
+        # Each half's topic has two subscribers (its robot and /whole): rosbag play waits for
+        # one, and a second's pause after advertising (-d) lets the other connect. Without both,
+        # a loaded machine lost a half's first scans to both mappers, uncounted.
+        play = ["rosbag", "play", "--clock", "-q", "--wait-for-subscribers", "-d", "1", "-r",
+                str(RATE)]
         commands = [
-            ["rosbag", "play", "--clock", "-q", "--wait-for-subscribers", "-r", str(RATE),
-             "-u", "%.3f" % split, str(path), "/scan:=/robot1/scan"],
-            ["rosbag", "play", "--clock", "-q", "-r", str(RATE), "-s", "%.3f" % split,
-             str(path), "/scan:=/robot2/scan"],
+            play + ["-u", "%.3f" % split, str(path), "/scan:=/robot1/scan"],
+            play + ["-s", "%.3f" % split, str(path), "/scan:=/robot2/scan"],
         ]
         started = time.time()
         for command in commands:
