@@ -2,15 +2,10 @@
 
 #include <algorithm>
 
+#include "tile_block.h"
+
 namespace mvog {
 namespace detail {
-namespace {
-
-std::uint64_t tileKey(std::int32_t x, std::int32_t y) {
-  return std::uint64_t{static_cast<std::uint32_t>(x)} << 32 | static_cast<std::uint32_t>(y);
-}
-
-}  // namespace
 
 void BlockSummaries::clear() {
   tiles_.clear();
