@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/Core>
+
 namespace mvog {
 
 /// Thrown by a config's validate() and by Map for invalid arguments; the message names the field.
@@ -78,6 +80,12 @@ struct MapConfig {
   double max_coordinate = 10000.0;
   /// How readings become volumes and how the lists are kept (saved with the map).
   ModelRules rules;
+
+  /// Whether `point` (m) is finite and within max_coordinate of the origin along every axis:
+  /// the only points readings and queries may reach.
+  bool withinBounds(const Eigen::Vector3d& point) const {
+    return point.allFinite() && point.cwiseAbs().maxCoeff() <= max_coordinate;
+  }
 
   /// Throws ConfigError naming the first invalid field.
   void validate() const;

@@ -41,7 +41,7 @@ void requireQueries(const Map& map, const PlanningConfig& config, const std::vec
   std::int64_t cells = 0;
   for (std::size_t k = 0; k < queries.size(); ++k) {
     for (const Eigen::Vector3d* point : pointsOf(queries[k])) {
-      if (!point->allFinite() || point->cwiseAbs().maxCoeff() > map.config().max_coordinate) {
+      if (!map.config().withinBounds(*point)) {
         throw ConfigError(std::string(what) + " " + std::to_string(k) +
                           ": a point is not finite or lies beyond the map's max_coordinate");
       }

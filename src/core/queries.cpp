@@ -56,8 +56,7 @@ OccupancyState bandState(const detail::ColumnRef& column, float low, float high,
 
 PointOccupancy Map::occupancy(const Eigen::Vector3d& point) const {
   PointOccupancy result;
-  if (!point.allFinite()) return result;
-  if (point.cwiseAbs().maxCoeff() > config_.max_coordinate) return result;
+  if (!config_.withinBounds(point)) return result;
   const CellIndex cell = cellAtPoint(point.x(), point.y());
   const detail::TileBlock* tile = findTile(detail::tileKeyOf(cell));
   if (tile == nullptr) return result;

@@ -165,13 +165,12 @@ double freeLengthOf(ReadingKind kind, const MapConfig& map_config, const Inserti
 bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, ReadingKind kind,
                    const MapConfig& map_config, const InsertionConfig& config,
                    Eigen::Vector3d& ray_end, bool& obstacle, InsertionResult& result) {
-  const double max_coordinate = map_config.max_coordinate;
   const bool is_obstacle = kind == ReadingKind::kObstacle;
   if (!origin.allFinite() || !end.allFinite()) {
     ++result.rejected_non_finite;
     return false;
   }
-  if (origin.cwiseAbs().maxCoeff() > max_coordinate || end.cwiseAbs().maxCoeff() > max_coordinate) {
+  if (!map_config.withinBounds(origin) || !map_config.withinBounds(end)) {
     ++result.rejected_out_of_bounds;
     return false;
   }
@@ -283,8 +282,7 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
   std::vector<double>& cells_in = split.cells_in_sector;
   sector_of.assign(num_readings, 0);
   cells_in.assign(kSectors, 0.0);
-  const bool origin_accepted =
-      scan.origin.allFinite() && scan.origin.cwiseAbs().maxCoeff() <= map_config.max_coordinate;
+  const bool origin_accepted = map_config.withinBounds(scan.origin);
   for (std::size_t k = 0; k < num_readings; ++k) {
     const bool is_hit = k < num_hits;
     const Eigen::Vector3d end =
@@ -293,8 +291,7 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
     const double length = ray.norm();
     // A reading that will be refused (acceptReading: not finite, beyond max_coordinate, at the
     // origin) costs about one cell.
-    if (!origin_accepted || !std::isfinite(length) ||
-        end.cwiseAbs().maxCoeff() > map_config.max_coordinate || length == 0.0) {
+    if (!origin_accepted || !map_config.withinBounds(end) || length == 0.0) {
       cells_in[0] += 1.0;
       continue;
     }
@@ -384,7 +381,7 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
     // The tiles of the chunk's rays (those it may accept) for the scratch's dense index.
     CellRange tiles = kNoCells;
     auto reach = [&](const Eigen::Vector3d& p) {
-      if (!p.allFinite() || p.cwiseAbs().maxCoeff() > map_config.max_coordinate) return;
+      if (!map_config.withinBounds(p)) return;
       const CellIndex cell = cellAt(p.x() * s, p.y() * s);
       tiles.extend(CellIndex{cell.x >> detail::kTileSizeLog2, cell.y >> detail::kTileSizeLog2});
     };

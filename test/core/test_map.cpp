@@ -436,6 +436,19 @@ TEST(Config, MapConfigFieldsAreChecked) {
   EXPECT_NO_THROW({ Map map(MapConfig{0.001, 4194.0, ModelRules{}}); });
 }
 
+TEST(Config, OnlyFinitePointsWithinMaxCoordinateOnEveryAxisAreWithinBounds) {
+  const MapConfig config{0.1, 100.0, {}};
+  EXPECT_TRUE(config.withinBounds({0.0, 0.0, 0.0}));
+  EXPECT_TRUE(config.withinBounds({100.0, -100.0, 100.0}));  // the bound itself is inside
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const double value : {100.001, -100.001, kInf, -kInf, kNaN}) {
+      Eigen::Vector3d point(1.0, 2.0, 3.0);
+      point[axis] = value;
+      EXPECT_FALSE(config.withinBounds(point)) << "axis " << axis << " at " << value;
+    }
+  }
+}
+
 TEST(Config, InsertionConfigFieldsAreChecked) {
   const auto with = [](auto change) {
     InsertionConfig config;
