@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Sanitizer builds and fuzzing (see RELIABILITY.md) in $WORKSPACE/sanitizers: plain CMake builds
-# (test/sanitizers, the programs of test/tests.cmake) and an instrumented catkin workspace:
-#   address  g++, AddressSanitizer + UndefinedBehaviorSanitizer (no recovery): the core gtests,
-#            the ROS conversion gtests, the concurrency and SIGKILL-during-save tests, and the
-#            fuzz corpora and regressions replayed through the fuzz targets' entry points;
-#   catkin   g++, ASan + UBSan: the catkin package's ROS gtests and the rostests of mvog_node
-#            (bad input, time jumps, SIGKILL during saves, overload, the whole ROS interface);
+# Sanitizer builds and fuzzing (see RELIABILITY.md) in $WORKSPACE/sanitizers: an instrumented
+# catkin workspace and plain CMake builds (test/sanitizers), of the programs of test/tests.cmake:
+#   catkin   g++ -O1, AddressSanitizer + UndefinedBehaviorSanitizer (float-cast-overflow too, no
+#            recovery, leaks checked): the core gtests, the ROS conversion and ROS gtests, the
+#            concurrency and SIGKILL-during-save tests, the fuzz corpora and regressions replayed
+#            through the fuzz targets' entry points, and the rostests of mvog_node (bad input,
+#            time jumps, SIGKILL during saves, overload, the whole ROS interface);
 #   thread   g++, ThreadSanitizer: the concurrency tests;
 #   fuzz     clang++-14, libFuzzer + ASan + UBSan: each target (map_file, map_update,
 #            conversions) for MVOG_FUZZ_SECONDS (25) seconds,
@@ -45,84 +45,101 @@ build() {
     quietly "sanitizer-$mode-build" cmake --build "$BUILD_ROOT/$mode" -j2 --target "$@"
 }
 
-# check NAME COMMAND...: runs one test program, its output in $LOG_DIR/NAME.log.
+# check NAME COMMAND...: runs one test program in the background, its output in
+# $LOG_DIR/NAME.log: two at a time, as most of them (and each fuzzer) use one core and the machine
+# has two. finish_checks waits for them and counts them.
+pending_checks=()
 check() {
   local name=$1
   shift
-  if "$@" >"$LOG_DIR/$name.log" 2>&1; then
-    passed=$((passed + 1))
-  else
-    fail "$name: see $LOG_DIR/$name.log"
-  fi
+  while [ "$(jobs -rp | wc -l)" -ge 2 ]; do wait -n || true; done
+  rm -f "$LOG_DIR/$name.passed"
+  ("$@" >"$LOG_DIR/$name.log" 2>&1 && touch "$LOG_DIR/$name.passed") &
+  pending_checks+=("$name")
+}
+finish_checks() {
+  wait
+  local name
+  for name in "${pending_checks[@]}"; do
+    if [ -f "$LOG_DIR/$name.passed" ]; then
+      passed=$((passed + 1))
+    else
+      fail "$name: see $LOG_DIR/$name.log"
+    fi
+  done
+  pending_checks=()
 }
 
 fuzz_targets=(map_file map_update conversions)
-asan_checks=(asan-core-gtests asan-conversions-gtests asan-concurrency asan-save-sigkill
-             "${fuzz_targets[@]/#/asan-replay-}")
-if build address g++ test_mvog_core test_mvog_ros_conversions test_concurrency test_save_sigkill \
-  "${fuzz_targets[@]/#/fuzz_replay_}"; then
-  dir=$BUILD_ROOT/address/mvog
-  check asan-core-gtests "$dir/test_mvog_core"
-  check asan-conversions-gtests "$dir/test_mvog_ros_conversions"
-  check asan-concurrency "$dir/test_concurrency"
-  check asan-save-sigkill "$dir/test_save_sigkill"
-  for target in "${fuzz_targets[@]}"; do
-    check "asan-replay-$target" "$dir/fuzz_replay_$target" "$REPO/test/fuzz/corpus/$target" \
-      "$REPO/test/fuzz/regressions/$target"
-  done
-else
-  for name in "${asan_checks[@]}"; do fail "$name: the address build failed"; done
-fi
 
-# The catkin package under ASan + UBSan: its ROS gtests and the rostests of mvog_node (not those
-# of the nodelet: an instrumented plugin cannot be loaded into Debian's uninstrumented nodelet
-# manager; not the replays of ../shared/data: minutes each). A sanitizer report by any process
-# fails the check and is appended to its log.
+# One instrumented catkin workspace for every ASan + UBSan check (each program is built once):
+# the core's and the ROS layer's gtests, the fuzz replays, and the rostests of mvog_node (not
+# those of the nodelet: an instrumented plugin cannot be loaded into Debian's uninstrumented
+# nodelet manager; not the replays of ../shared/data: minutes each). -O1 as ASan's authors
+# advise: less compile time than -O2 for the same checks. A sanitizer report by any
+# process fails the check and is appended to its log.
 asan_workspace=$BUILD_ROOT/catkin
-asan_reports=$LOG_DIR/asan-ros
-sanitize="-fsanitize=address,undefined -fno-sanitize-recover=all"
-# in_asan_workspace COMMAND...: runs COMMAND with the instrumented workspace sourced.
+sanitize="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all"
+# in_asan_workspace NAME COMMAND...: runs COMMAND with the instrumented workspace sourced, its
+# sanitizer reports in $LOG_DIR/asan-reports/NAME.
 in_asan_workspace() {
-  rm -rf "$asan_reports"
-  mkdir -p "$asan_reports"
+  local reports=$LOG_DIR/asan-reports/$1
+  shift
+  rm -rf "$reports"
+  mkdir -p "$reports"
   if (
     set +u
     # shellcheck disable=SC1091
     source "$asan_workspace/devel/setup.bash"
     set -u
-    export ASAN_OPTIONS=detect_leaks=1:log_path=$asan_reports/asan
-    export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:log_path=$asan_reports/ubsan
+    export ASAN_OPTIONS=detect_leaks=1:log_path=$reports/asan
+    export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:log_path=$reports/ubsan
     export ROS_TEST_RESULTS_DIR=$asan_workspace/test_results
     "$@"
-  ) && [ -z "$(ls -A "$asan_reports")" ]; then
+  ) && [ -z "$(ls -A "$reports")" ]; then
     return 0
   fi
-  cat "$asan_reports"/* 2>/dev/null || true
+  cat "$reports"/* 2>/dev/null || true
   return 1
 }
+asan_programs=(test_mvog_core test_mvog_ros_conversions test_concurrency test_save_sigkill
+               test_mvog_ros)
 asan_ros_tests=(mapper_node decay bad_input time_jump kill_during_save overload planning)
 mkdir -p "$asan_workspace/src"
 # shellcheck disable=SC2031 # in_asan_workspace's subshell sources setup.bash, unseen: not REPO
 ln -sfn "$REPO" "$asan_workspace/src/mvog"
 if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS="$sanitize -fno-omit-frame-pointer" \
-  -DCMAKE_EXE_LINKER_FLAGS="$sanitize" -DCMAKE_SHARED_LINKER_FLAGS="$sanitize" \
-  -DCATKIN_ENABLE_TESTING=ON -j2 mvog_node test_mvog_ros test_mapper_node test_planning_node \
-  mvog_generate_messages); then
-  check asan-ros-gtests in_asan_workspace "$asan_workspace/devel/lib/mvog/test_mvog_ros"
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DCMAKE_CXX_FLAGS="$sanitize -fno-omit-frame-pointer" -DCMAKE_EXE_LINKER_FLAGS="$sanitize" \
+  -DCMAKE_SHARED_LINKER_FLAGS="$sanitize" -DCATKIN_ENABLE_TESTING=ON -DMVOG_FUZZ_TARGETS=replay \
+  -j2 mvog_node test_mapper_node test_planning_node mvog_generate_messages "${asan_programs[@]}" \
+  "${fuzz_targets[@]/#/fuzz_replay_}"); then
+  dir=$asan_workspace/devel/lib/mvog
+  for program in "${asan_programs[@]}"; do
+    check "asan-${program#test_}" in_asan_workspace "${program#test_}" "$dir/$program"
+  done
+  for target in "${fuzz_targets[@]}"; do
+    # shellcheck disable=SC2031 # as above
+    check "asan-replay-$target" in_asan_workspace "replay-$target" "$dir/fuzz_replay_$target" \
+      "$REPO/test/fuzz/corpus/$target" "$REPO/test/fuzz/regressions/$target"
+  done
   for test in "${asan_ros_tests[@]}"; do
-    check "asan-rostest-$test" in_asan_workspace rostest mvog "$test.test"
+    check "asan-rostest-$test" in_asan_workspace "rostest-$test" rostest mvog "$test.test"
   done
 else
-  fail "asan-ros-gtests: the instrumented catkin build failed"
-  for test in "${asan_ros_tests[@]}"; do fail "asan-rostest-$test: the instrumented catkin build failed"; done
+  for name in "${asan_programs[@]#test_}" "${fuzz_targets[@]/#/replay-}" \
+    "${asan_ros_tests[@]/#/rostest-}"; do
+    fail "asan-$name: the instrumented catkin build failed"
+  done
 fi
+finish_checks  # before the next build takes both cores
 
 if build thread g++ test_concurrency; then
   check tsan-concurrency "$BUILD_ROOT/thread/mvog/test_concurrency"
 else
   fail "tsan-concurrency: the thread build failed"
 fi
+finish_checks
 
 # shellcheck disable=SC2031 # as above
 if build fuzz clang++-14 "${fuzz_targets[@]/#/fuzz_}"; then
@@ -138,6 +155,7 @@ if build fuzz clang++-14 "${fuzz_targets[@]/#/fuzz_}"; then
 else
   for target in "${fuzz_targets[@]}"; do fail "fuzz-$target: the fuzz build failed"; done
 fi
+finish_checks
 
 for failure in "${failures[@]}"; do echo "FAILED: $failure"; done
 echo "sanitizers: $passed passed, $failed failed, 0 skipped"

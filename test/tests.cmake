@@ -1,10 +1,13 @@
 # Every test of the project, each C++ test program with its one list of sources. Included by the
 # top-level CMakeLists.txt in each of its builds, which declares a program only where the
 # libraries it links are built:
-#   catkin              every program below and the rostests (catkin_make run_tests);
+#   catkin              every program below and the rostests (catkin_make run_tests); with
+#                       MVOG_FUZZ_TARGETS=replay the fuzz replays too (the ASan + UBSan
+#                       workspace of scripts/sanitizers.sh);
 #   plain CMake         the core's (cmake -DMVOG_BUILD_ROS=OFF, ctest), and with
 #                       MVOG_BUILD_ROS_CONVERSIONS those of mvog_ros_conversions too;
-#   test/sanitizers     plain CMake instrumented (scripts/sanitizers.sh), with the fuzz targets.
+#   test/sanitizers     plain CMake instrumented (scripts/sanitizers.sh: TSan, and libFuzzer with
+#                       the fuzz targets).
 
 # mvog_add_gtest(NAME SOURCES file... LIBRARIES target...): a gtest program, run by catkin's
 # run_tests or by ctest.
