@@ -188,5 +188,19 @@ inline ::testing::AssertionResult sameAsReference(const Map& map, const Referenc
   return ::testing::AssertionSuccess();
 }
 
+/// A map beside the reference model, with the same configuration and fed the same scans.
+struct MapBesideReference {
+  explicit MapBesideReference(const MapConfig& config) : map(config), reference(config) {}
+  /// Inserts `scan` into both; whether they then hold the same.
+  ::testing::AssertionResult insert(const Scan& scan) {
+    map.insertScan(scan);
+    reference.insertScan(scan);
+    return sameAsReference(map, reference);
+  }
+
+  Map map;
+  ReferenceModel reference;
+};
+
 }  // namespace test
 }  // namespace mvog

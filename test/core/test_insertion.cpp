@@ -666,17 +666,9 @@ TEST(Insertion, EveryRuleSetEqualsThePlainReference) {
   // shortcuts and tiles written in place change nothing the rules decide.
   for (const ModelRules& rules : everyRuleSet()) {
     SCOPED_TRACE(describe(rules));
-    MapConfig map_config;
-    map_config.resolution = 0.25;
-    map_config.rules = rules;
-    Map map(map_config);
-    test::ReferenceModel reference(map_config);
-    for (const Scan& scan : testScans(17)) {
-      map.insertScan(scan);
-      reference.insertScan(scan);
-      ASSERT_TRUE(test::sameAsReference(map, reference));
-    }
-    EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+    test::MapBesideReference maps(MapConfig{0.25, 10000.0, rules});
+    for (const Scan& scan : testScans(17)) ASSERT_TRUE(maps.insert(scan));
+    EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
   }
 }
 
@@ -690,20 +682,14 @@ TEST(Insertion, ATileRewrittenForSomeCellsKeepsItsOtherCells) {
                                                       {0, 8}, {15, 11}, {0, 12}, {15, 15}};
   for (const ModelRules& rules : {ModelRules::paper(), ModelRules{}}) {
     SCOPED_TRACE(describe(rules));
-    MapConfig map_config;
-    map_config.resolution = 1.0;
-    map_config.rules = rules;
-    Map map(map_config);
-    test::ReferenceModel reference(map_config);
+    test::MapBesideReference maps(test::unitConfig(10000.0, rules));
     // A vertical reading in cell (x, y) from height `from` down (or up) to a hit at `to`.
     auto vertical = [&](int x, int y, double from, double to) {
       Scan scan;
       scan.origin = {x + 0.5, y + 0.5, from};
       scan.hits.push_back(
           {static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, static_cast<float>(to)});
-      map.insertScan(scan);
-      reference.insertScan(scan);
-      return test::sameAsReference(map, reference);
+      return maps.insert(scan);
     };
     for (const auto& [x, y] : word_ends) ASSERT_TRUE(vertical(x, y, 0.5, 5.5));
     for (const auto& [x, y] : {word_ends[1], word_ends[2], word_ends[5], word_ends[6]}) {
@@ -711,9 +697,9 @@ TEST(Insertion, ATileRewrittenForSomeCellsKeepsItsOtherCells) {
     }
     ASSERT_TRUE(vertical(4, 6, 0.5, 2.5));  // local 100: a new cell amid the others
     for (int k = 0; k < 300; ++k) ASSERT_TRUE(vertical(7, 9, 1000.5, 40.0 + 3.0 * k));
-    EXPECT_EQ(map.cellVolumes({7, 9}).positive.size(), 300u);
+    EXPECT_EQ(maps.map.cellVolumes({7, 9}).positive.size(), 300u);
     for (const auto& [x, y] : word_ends) ASSERT_TRUE(vertical(x, y, 60.5, 70.5));
-    EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+    EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
   }
 }
 
