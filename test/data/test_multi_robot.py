@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 import rosbag
+import rosgraph
 import rospy
 from geometry_msgs.msg import Point
 from rosgraph_msgs.msg import Clock
@@ -31,6 +32,7 @@ BAG = "intel_lab.bag"
 README_SCANS = 910
 RATE = 50
 ROBOTS = ["/robot1/mvog_mapper", "/robot2/mvog_mapper"]
+SCAN_TOPICS = ["/robot1/scan", "/robot2/scan"]
 MIRRORS = ["/base/robot1/mvog_mirror", "/base/robot2/mvog_mirror"]
 MERGED, WHOLE = "/base/mvog_merged", "/whole/mvog_mapper"
 LASER_HEIGHT = 0.3  # the data README's (synthetic) mount height
@@ -42,6 +44,18 @@ def states(ns, points):
         frame_id="", points=[Point(*map(float, p)) for p in points])
     assert response.success, response.message
     return np.frombuffer(bytes(response.state), dtype=np.uint8).copy()
+
+
+def wait_for_subscribers(topic, nodes, timeout=60.0):
+    """Waits until every one of `nodes` has subscribed to `topic` (as the master knows)."""
+    master = rosgraph.Master(rospy.get_name())
+    deadline = time.time() + timeout
+    while True:
+        subscribed = dict(master.getSystemState()[1]).get(topic, [])
+        if all(node in subscribed for node in nodes):
+            return
+        assert time.time() < deadline, "%s: only %s of %s subscribed" % (topic, subscribed, nodes)
+        time.sleep(0.1)
 
 
 class MultiRobot(data.DataTestCase):
@@ -61,14 +75,17 @@ class MultiRobot(data.DataTestCase):
         for ns in ROBOTS + [WHOLE]:
             rospy.Subscriber(ns + "/statistics", MapStatistics, cls._on_statistics,
                              callback_args=ns)
-        # Each half's topic has two subscribers (its robot and /whole): rosbag play waits for
-        # one, and a second's pause after advertising (-d) lets the other connect. Without both,
-        # a loaded machine lost a half's first scans to both mappers, uncounted.
+        # Each half's topic has two subscribers (its robot and /whole), and roscpp drops what
+        # it publishes before they connect, uncounted (a loaded machine lost the first scans of a
+        # half so): both must have subscribed before the bag is played; rosbag play waits for
+        # one to connect, and a second's pause after advertising (-d) lets the other connect.
+        for robot, topic in zip(ROBOTS, SCAN_TOPICS):
+            wait_for_subscribers(topic, [robot, WHOLE])
         play = ["rosbag", "play", "--clock", "-q", "--wait-for-subscribers", "-d", "1", "-r",
                 str(RATE)]
         commands = [
-            play + ["-u", "%.3f" % split, str(path), "/scan:=/robot1/scan"],
-            play + ["-s", "%.3f" % split, str(path), "/scan:=/robot2/scan"],
+            play + ["-u", "%.3f" % split, str(path), "/scan:=" + SCAN_TOPICS[0]],
+            play + ["-s", "%.3f" % split, str(path), "/scan:=" + SCAN_TOPICS[1]],
         ]
         started = time.time()
         for command in commands:
@@ -80,17 +97,21 @@ class MultiRobot(data.DataTestCase):
         clock = rospy.Publisher("/clock", Clock, queue_size=10)
         now, deadline = end, time.time() + 180.0
         previous, stable_since = None, None
+        waiting_for = "every scan counted"
         while True:
-            assert time.time() < deadline, "the maps did not settle: %s" % cls.describe()
+            assert time.time() < deadline, "the maps did not settle, waiting for %s: %s" % (
+                waiting_for, cls.describe())
             for _ in range(50):  # 0.5 s of the clock
                 now += 0.01
                 clock.publish(Clock(clock=rospy.Time.from_sec(now)))
                 time.sleep(0.002)
             if not cls.all_inserted():
                 continue
+            waiting_for = "each mirror to hold its robot's map"
             snapshots = {ns: node.snapshot() for ns, node in cls.nodes.items()}
             if any(snapshots[m] != snapshots[r] for m, r in zip(MIRRORS, ROBOTS)):
                 continue
+            waiting_for = "the merged map to stay unchanged"
             if snapshots[MERGED] != previous:
                 previous, stable_since = snapshots[MERGED], now
             elif now - stable_since >= 4.0:
@@ -120,8 +141,10 @@ class MultiRobot(data.DataTestCase):
 
     @classmethod
     def describe(cls):
-        return ", ".join("%s: %d inserted" % (ns, s.messages_inserted)
-                         for ns, s in sorted(cls.statistics.items()))
+        return ", ".join("%s: %d inserted, %d dropped (tf %d, queue %d, invalid %d)" % (
+            ns, s.messages_inserted, s.messages_dropped_tf + s.messages_dropped_queue +
+            s.messages_dropped_invalid, s.messages_dropped_tf, s.messages_dropped_queue,
+            s.messages_dropped_invalid) for ns, s in sorted(cls.statistics.items()))
 
     def test_every_scan_inserted_once(self):
         for ns, count in list(zip(ROBOTS, self.halves)) + [(WHOLE, README_SCANS)]:
