@@ -18,7 +18,7 @@ MVOG_PACKAGES=(
   build-essential cmake libeigen3-dev libgtest-dev libbenchmark-dev
   ros-core-python-dev ros-base-dev python3-rostest rosbash python3-rosbag python3-numpy
   python3-rospy python3-sensor-msgs python3-geometry-msgs python3-tf2-msgs python3-tf2-ros
-  python3-diagnostic-msgs
+  python3-diagnostic-msgs python3-std-srvs
   libpcl-dev libtf2-ros-dev libtf2-eigen-dev libtf2-msgs-dev libstd-srvs-dev
   libvisualization-msgs-dev libnav-msgs-dev libmap-msgs-dev libdiagnostic-updater-dev
   libimage-transport-dev

@@ -13,6 +13,7 @@ import os
 import subprocess
 import sys
 import time
+import xmlrpc.client
 
 import numpy as np
 import rosbag
@@ -20,6 +21,7 @@ import rosgraph
 import rospy
 from geometry_msgs.msg import Point
 from rosgraph_msgs.msg import Clock
+from std_srvs.srv import SetBool
 
 import mvog_data_test as data
 from mvog.msg import MapStatistics
@@ -46,16 +48,34 @@ def states(ns, points):
     return np.frombuffer(bytes(response.state), dtype=np.uint8).copy()
 
 
-def wait_for_subscribers(topic, nodes, timeout=60.0):
-    """Waits until every one of `nodes` has subscribed to `topic` (as the master knows)."""
-    master = rosgraph.Master(rospy.get_name())
-    deadline = time.time() + timeout
-    while True:
-        subscribed = dict(master.getSystemState()[1]).get(topic, [])
-        if all(node in subscribed for node in nodes):
-            return
-        assert time.time() < deadline, "%s: only %s of %s subscribed" % (topic, subscribed, nodes)
-        time.sleep(0.1)
+def play_when_connected(command, name, topic, subscribers, timeout=60.0):
+    """Runs `command` (rosbag play) as node `name`, paused until each of `subscribers` is
+    connected to its `topic`: roscpp drops, uncounted, what is published before a subscriber has
+    connected, and on a loaded machine that took more than rosbag play's waits allow (a CI run
+    lost a half's first scans to one server or both)."""
+    process = subprocess.Popen(command + ["--pause", "__name:=" + name],
+                               stdin=subprocess.DEVNULL)
+    try:
+        master = rosgraph.Master(rospy.get_name())
+        deadline = time.time() + timeout
+        connected = set()
+        while not all(subscriber in connected for subscriber in subscribers):
+            assert process.poll() is None, "%s exited (%d)" % (name, process.returncode)
+            assert time.time() < deadline, "%s: only %s connected" % (topic, sorted(connected))
+            time.sleep(0.1)
+            try:
+                bus = xmlrpc.client.ServerProxy(master.lookupNode("/" + name)).getBusInfo(
+                    rospy.get_name())[2]
+            except (rosgraph.MasterError, OSError):
+                continue  # not registered yet
+            # roscpp's bus info: [id, the other end's node, "o" (outbound), transport, topic, ...]
+            connected = {link[1] for link in bus if link[2] == "o" and link[4] == topic}
+        rospy.ServiceProxy("/" + name + "/pause_playback", SetBool)(False)
+        assert process.wait(timeout=120) == 0, "%s failed" % name
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
 
 
 class MultiRobot(data.DataTestCase):
@@ -75,21 +95,13 @@ class MultiRobot(data.DataTestCase):
         for ns in ROBOTS + [WHOLE]:
             rospy.Subscriber(ns + "/statistics", MapStatistics, cls._on_statistics,
                              callback_args=ns)
-        # Each half's topic has two subscribers (its robot and /whole), and roscpp drops what
-        # it publishes before they connect, uncounted (a loaded machine lost the first scans of a
-        # half so): both must have subscribed before the bag is played; rosbag play waits for
-        # one to connect, and a second's pause after advertising (-d) lets the other connect.
-        for robot, topic in zip(ROBOTS, SCAN_TOPICS):
-            wait_for_subscribers(topic, [robot, WHOLE])
-        play = ["rosbag", "play", "--clock", "-q", "--wait-for-subscribers", "-d", "1", "-r",
-                str(RATE)]
-        commands = [
-            play + ["-u", "%.3f" % split, str(path), "/scan:=" + SCAN_TOPICS[0]],
-            play + ["-s", "%.3f" % split, str(path), "/scan:=" + SCAN_TOPICS[1]],
-        ]
+        # Each half's topic has two subscribers: its robot and /whole.
+        play = ["rosbag", "play", "--clock", "-q", "-r", str(RATE), str(path)]
         started = time.time()
-        for command in commands:
-            subprocess.run(command, check=True, timeout=120, stdin=subprocess.DEVNULL)
+        play_when_connected(play + ["-u", "%.3f" % split, "/scan:=" + SCAN_TOPICS[0]],
+                            "multi_robot_first_half", SCAN_TOPICS[0], [ROBOTS[0], WHOLE])
+        play_when_connected(play + ["-s", "%.3f" % split, "/scan:=" + SCAN_TOPICS[1]],
+                            "multi_robot_second_half", SCAN_TOPICS[1], [ROBOTS[1], WHOLE])
         cls.play_seconds = time.time() - started
 
         # The clock on past the bag's end until each map holds every scan, each mirror is its
