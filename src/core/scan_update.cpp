@@ -166,12 +166,12 @@ bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, Re
                    const MapConfig& map_config, const InsertionConfig& config,
                    Eigen::Vector3d& ray_end, bool& obstacle, InsertionResult& result) {
   const bool is_obstacle = kind == ReadingKind::kObstacle;
-  if (!origin.allFinite() || !end.allFinite()) {
-    ++result.rejected_non_finite;
-    return false;
-  }
   if (!map_config.withinBounds(origin) || !map_config.withinBounds(end)) {
-    ++result.rejected_out_of_bounds;
+    if (!origin.allFinite() || !end.allFinite()) {
+      ++result.rejected_non_finite;
+    } else {
+      ++result.rejected_out_of_bounds;
+    }
     return false;
   }
   const Eigen::Vector3d ray = end - origin;
