@@ -9,6 +9,15 @@ source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 install_missing_packages
 
+# stage NAME: ends the stage running since the last call (or the installation), its time in
+# `stage_times` (printed before the summary).
+stage_times=()
+stage_started=$SECONDS
+stage() {
+  stage_times+=("$1 $((SECONDS - stage_started)) s")
+  stage_started=$SECONDS
+}
+
 passed=0
 failed=0
 skipped=0
@@ -37,10 +46,12 @@ else
   failed=$((failed + 1))
   failures+=("core (plain CMake): see $LOG_DIR/core-build.log and $LOG_DIR/core-includes.log")
 fi
+stage "format and core"
 
 # 2. The catkin package: gtests and rostests.
 build_workspace
 source_workspace
+stage "catkin build"
 
 rm -rf "$WORKSPACE/build/test_results"
 quietly run-tests bash -c "cd '$WORKSPACE' && catkin_make run_tests -j2" || true
@@ -56,6 +67,7 @@ skipped=$((skipped + test_skipped))
 if [ $((errors + test_failures)) -gt 0 ] || [ "$tests" -eq 0 ]; then
   failures+=("catkin tests: $(grep -vE '^Summary:' <<<"$results" | grep -E 'errors|failures|Error' | head -20)")
 fi
+stage "catkin tests"
 
 # count_script NAME: adds the counts of scripts/NAME.sh from its log, whose last line is
 # "NAME: N passed, N failed, N skipped" (one failure if it printed none).
@@ -75,11 +87,15 @@ count_script() {
 # the build above. Not beside the catkin tests: their replays at 50x lost scans on a loaded machine.
 bash "$REPO/scripts/lint.sh" >"$LOG_DIR/lint.log" 2>&1 || true
 count_script lint
+stage linters
 
 # 4. Sanitizer builds and fuzzing: ASan + UBSan, TSan, libFuzzer.
 bash "$REPO/scripts/sanitizers.sh" >"$LOG_DIR/sanitizers.log" 2>&1 || true
 count_script sanitizers
+stage sanitizers
 
 for failure in "${failures[@]}"; do echo "FAILED: $failure"; done
+joined_times=$(printf '%s, ' "${stage_times[@]}")
+echo "times: ${joined_times%, }; in all $SECONDS s"
 echo "tests: $passed passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ] && [ ${#failures[@]} -eq 0 ]
