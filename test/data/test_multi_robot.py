@@ -51,8 +51,9 @@ def states(ns, points):
 def play_when_connected(command, name, topic, subscribers, timeout=60.0):
     """Runs `command` (rosbag play) as node `name`, paused until each of `subscribers` is
     connected to its `topic`: roscpp drops, uncounted, what is published before a subscriber has
-    connected, and on a loaded machine that took more than rosbag play's waits allow (a CI run
-    lost a half's first scans to one server or both)."""
+    connected, and rosbag play's own waits (for one subscriber, then a fixed pause) do not wait
+    for every subscriber. On a loaded machine, runs without this ended with one server or both
+    short of a half's scans, none counted."""
     process = subprocess.Popen(command + ["--pause", "__name:=" + name],
                                stdin=subprocess.DEVNULL)
     try:
