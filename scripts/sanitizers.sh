@@ -76,8 +76,10 @@ fuzz_targets=(map_file map_update conversions)
 # the core's and the ROS layer's gtests, the fuzz replays, and the rostests of mvog_node (not
 # those of the nodelet: an instrumented plugin cannot be loaded into Debian's uninstrumented
 # nodelet manager; not the replays of ../shared/data: minutes each). -O1 as ASan's authors
-# advise: less compile time than -O2 for the same checks. A sanitizer report by any
-# process fails the check and is appended to its log.
+# advise: less compile time than -O2 for the same checks; -g1: the line tables a report's stack
+# trace needs (file:line), without -g's variable descriptions (objects 2.4x smaller, ROS sources
+# 14 % faster to compile). A sanitizer report by any process fails the check and is appended to
+# its log.
 asan_workspace=$BUILD_ROOT/catkin
 sanitize="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all"
 # in_asan_workspace NAME COMMAND...: runs COMMAND with the instrumented workspace sourced, its
@@ -109,7 +111,7 @@ mkdir -p "$asan_workspace/src"
 # shellcheck disable=SC2031 # in_asan_workspace's subshell sources setup.bash, unseen: not REPO
 ln -sfn "$REPO" "$asan_workspace/src/mvog"
 if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DCMAKE_CXX_FLAGS="$sanitize -fno-omit-frame-pointer" -DCMAKE_EXE_LINKER_FLAGS="$sanitize" \
   -DCMAKE_SHARED_LINKER_FLAGS="$sanitize" -DCATKIN_ENABLE_TESTING=ON -DMVOG_FUZZ_TARGETS=replay \
   -j2 mvog_node test_mapper_node test_planning_node mvog_generate_messages "${asan_programs[@]}" \
