@@ -110,14 +110,39 @@ asan_ros_tests=(mapper_node decay bad_input time_jump kill_during_save overload 
 mkdir -p "$asan_workspace/src"
 # shellcheck disable=SC2031 # in_asan_workspace's subshell sources setup.bash, unseen: not REPO
 ln -sfn "$REPO" "$asan_workspace/src/mvog"
+# The three builds first, each with both cores; then every check that times nothing (the
+# gtests, the corpus replays, TSan, the fuzzers) two at a time, the longest first, so that no core
+# waits for the last of a batch; then the ASan rostests, alone.
+asan_built=false
 if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DCMAKE_CXX_FLAGS="$sanitize -fno-omit-frame-pointer" -DCMAKE_EXE_LINKER_FLAGS="$sanitize" \
   -DCMAKE_SHARED_LINKER_FLAGS="$sanitize" -DCATKIN_ENABLE_TESTING=ON -DMVOG_FUZZ_TARGETS=replay \
   -j2 mvog_node test_mapper_node test_planning_node mvog_generate_messages "${asan_programs[@]}" \
   "${fuzz_targets[@]/#/fuzz_replay_}"); then
+  asan_built=true
+else
+  for name in "${asan_programs[@]#test_}" "${fuzz_targets[@]/#/replay-}" \
+    "${asan_ros_tests[@]/#/rostest-}"; do
+    fail "asan-$name: the instrumented catkin build failed"
+  done
+fi
+thread_built=false
+if build thread g++ test_concurrency; then
+  thread_built=true
+else
+  fail "tsan-concurrency: the thread build failed"
+fi
+fuzz_built=false
+if build fuzz clang++-14 "${fuzz_targets[@]/#/fuzz_}"; then
+  fuzz_built=true
+else
+  for target in "${fuzz_targets[@]}"; do fail "fuzz-$target: the fuzz build failed"; done
+fi
+
+if $asan_built; then
   dir=$asan_workspace/devel/lib/mvog
-  for program in "${asan_programs[@]}"; do
+  for program in "${asan_programs[@]}"; do  # test_mvog_core, the longest, first
     check "asan-${program#test_}" in_asan_workspace "${program#test_}" "$dir/$program"
   done
   for target in "${fuzz_targets[@]}"; do
@@ -125,30 +150,12 @@ if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make \
     check "asan-replay-$target" in_asan_workspace "replay-$target" "$dir/fuzz_replay_$target" \
       "$REPO/test/fuzz/corpus/$target" "$REPO/test/fuzz/regressions/$target"
   done
-  # The rostests one at a time: their servers answer within deadlines, and under ASan beside
-  # another test the planning test's tf lookups missed them.
-  finish_checks
-  for test in "${asan_ros_tests[@]}"; do
-    check "asan-rostest-$test" in_asan_workspace "rostest-$test" rostest mvog "$test.test"
-    finish_checks
-  done
-else
-  for name in "${asan_programs[@]#test_}" "${fuzz_targets[@]/#/replay-}" \
-    "${asan_ros_tests[@]/#/rostest-}"; do
-    fail "asan-$name: the instrumented catkin build failed"
-  done
 fi
-finish_checks  # before the next build takes both cores
-
-if build thread g++ test_concurrency; then
+if $thread_built; then
   check tsan-concurrency "$BUILD_ROOT/thread/mvog/test_concurrency"
-else
-  fail "tsan-concurrency: the thread build failed"
 fi
-finish_checks
-
 # shellcheck disable=SC2031 # as above
-if build fuzz clang++-14 "${fuzz_targets[@]/#/fuzz_}"; then
+if $fuzz_built; then
   for target in "${fuzz_targets[@]}"; do
     # New inputs go to the first directory (kept between local runs); the others only seed.
     mkdir -p "$BUILD_ROOT/fuzz/corpus/$target"
@@ -158,10 +165,17 @@ if build fuzz clang++-14 "${fuzz_targets[@]/#/fuzz_}"; then
       -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
       -artifact_prefix="$FUZZ_LOGS/$target-" "$BUILD_ROOT/fuzz/corpus/$target" "${seeds[@]}"
   done
-else
-  for target in "${fuzz_targets[@]}"; do fail "fuzz-$target: the fuzz build failed"; done
 fi
 finish_checks
+
+# The rostests one at a time: their servers answer within deadlines, and under ASan beside
+# another test the planning test's tf lookups missed them.
+if $asan_built; then
+  for test in "${asan_ros_tests[@]}"; do
+    check "asan-rostest-$test" in_asan_workspace "rostest-$test" rostest mvog "$test.test"
+    finish_checks
+  done
+fi
 
 for failure in "${failures[@]}"; do echo "FAILED: $failure"; done
 echo "sanitizers: $passed passed, $failed failed, 0 skipped"
