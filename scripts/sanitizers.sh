@@ -77,9 +77,8 @@ fuzz_targets=(map_file map_update conversions)
 # those of the nodelet: an instrumented plugin cannot be loaded into Debian's uninstrumented
 # nodelet manager; not the replays of ../shared/data: minutes each). -O1 as ASan's authors
 # advise: less compile time than -O2 for the same checks; -g1: the line tables a report's stack
-# trace needs (file:line), without -g's variable descriptions (objects 2.4x smaller, ROS sources
-# 14 % faster to compile). A sanitizer report by any process fails the check and is appended to
-# its log.
+# trace needs (file:line), without -g's variable descriptions (less to compile and link). A
+# sanitizer report by any process fails the check and is appended to its log.
 asan_workspace=$BUILD_ROOT/catkin
 sanitize="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all"
 # in_asan_workspace NAME COMMAND...: runs COMMAND with the instrumented workspace sourced, its
@@ -111,8 +110,8 @@ mkdir -p "$asan_workspace/src"
 # shellcheck disable=SC2031 # in_asan_workspace's subshell sources setup.bash, unseen: not REPO
 ln -sfn "$REPO" "$asan_workspace/src/mvog"
 # The three builds first, each with both cores; then every check that times nothing (the
-# gtests, the corpus replays, TSan, the fuzzers) two at a time, the longest first, so that no core
-# waits for the last of a batch; then the ASan rostests, alone.
+# gtests, the corpus replays, TSan, the fuzzers) two at a time, test_mvog_core (the longest)
+# first, so that no core waits for the last of a batch; then the ASan rostests, alone.
 asan_built=false
 if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
@@ -142,7 +141,7 @@ fi
 
 if $asan_built; then
   dir=$asan_workspace/devel/lib/mvog
-  for program in "${asan_programs[@]}"; do  # test_mvog_core, the longest, first
+  for program in "${asan_programs[@]}"; do
     check "asan-${program#test_}" in_asan_workspace "${program#test_}" "$dir/$program"
   done
   for target in "${fuzz_targets[@]}"; do
