@@ -73,9 +73,9 @@ struct ColumnWork {
   ListMerger merger;
   /// The scratches that reached the tile being updated, and their part of it.
   std::vector<std::pair<const detail::ScanScratch*, const detail::ScratchTile*>> parts;
-  std::vector<detail::TileHit> hits;                       // the tile's, by cell
-  std::uint32_t hits_per_cell[detail::kCellsPerTile + 1];  // where each cell's start in hits
-  std::uint64_t reached[detail::kCellsPerTile / 64];       // the cells the scan reached
+  std::vector<detail::TileHit> hits;  // the tile's, by cell (gatherTile)
+  std::vector<detail::TileHit> sorted_hits;
+  std::uint64_t reached[detail::kCellsPerTile / 64];  // the cells the scan reached
   std::vector<ScanInterval> free;
   std::vector<ScanInterval> positive;
   CellVolumes added;
@@ -89,52 +89,79 @@ struct ColumnWork {
 
 namespace {
 
-/// Gathers what the scan's scratches hold for tile `key`: its parts, and its hits by cell.
+/// Whether hit a comes before hit b: by cell, then by height.
+bool hitBefore(const detail::TileHit& a, const detail::TileHit& b) {
+  return std::tie(a.local, a.bottom, a.top) < std::tie(b.local, b.bottom, b.top);
+}
+
+/// Gathers what the scan's scratches hold for tile `key`: its parts, and its hits by cell, each
+/// cell's by height.
 void gatherTile(std::uint64_t key, const std::vector<detail::ScanScratch>& scratches,
                 ColumnWork& work) {
   work.parts.clear();
+  work.hits.clear();
   std::fill(std::begin(work.reached), std::end(work.reached), std::uint64_t{0});
-  std::size_t num_hits = 0;
   for (const detail::ScanScratch& scratch : scratches) {
     if (const detail::ScratchTile* part = scratch.find(key)) {
       work.parts.emplace_back(&scratch, part);
-      num_hits += part->hits.size();
+      work.hits.insert(work.hits.end(), part->hits.begin(), part->hits.end());
       for (std::size_t w = 0; w < std::size(work.reached); ++w) work.reached[w] |= part->reached[w];
     }
   }
-  work.hits.resize(num_hits);
-  if (num_hits == 0) return;
-  // The hits by cell (a counting sort), each cell's sorted by height.
-  std::fill(std::begin(work.hits_per_cell), std::end(work.hits_per_cell), 0u);
-  for (const auto& part : work.parts) {
-    for (const detail::TileHit& hit : part.second->hits) ++work.hits_per_cell[hit.local + 1];
+  // A tile mostly holds a few hits: sorted as they are. Many (a dense camera's) are first
+  // counted by cell, which costs a pass over the tile's cells.
+  constexpr std::size_t kFewHits = 32;
+  if (work.hits.size() <= kFewHits) {
+    std::sort(work.hits.begin(), work.hits.end(), hitBefore);
+    return;
   }
+  std::uint32_t cell_start[detail::kCellsPerTile + 1] = {};
+  for (const detail::TileHit& hit : work.hits) ++cell_start[hit.local + 1];
   for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
-    work.hits_per_cell[local + 1] += work.hits_per_cell[local];
+    cell_start[local + 1] += cell_start[local];
   }
-  std::uint32_t next[detail::kCellsPerTile];
-  std::copy(work.hits_per_cell, work.hits_per_cell + detail::kCellsPerTile, next);
-  for (const auto& part : work.parts) {
-    for (const detail::TileHit& hit : part.second->hits) work.hits[next[hit.local]++] = hit;
-  }
-  auto lower = [](const detail::TileHit& a, const detail::TileHit& b) {
-    return std::tie(a.bottom, a.top) < std::tie(b.bottom, b.top);
-  };
+  work.sorted_hits.resize(work.hits.size());
+  for (const detail::TileHit& hit : work.hits) work.sorted_hits[cell_start[hit.local]++] = hit;
+  std::swap(work.hits, work.sorted_hits);
+  // cell_start[local] is now where cell local + 1 starts.
+  auto first = work.hits.begin();
   for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
-    const auto first = work.hits.begin() + work.hits_per_cell[local];
-    const auto last = work.hits.begin() + work.hits_per_cell[local + 1];
-    if (last - first > 1 && !std::is_sorted(first, last, lower)) std::sort(first, last, lower);
+    const auto last = work.hits.begin() + cell_start[local];
+    if (last - first > 1 && !std::is_sorted(first, last, hitBefore))
+      std::sort(first, last, hitBefore);
+    first = last;
   }
 }
 
-/// The number of hits the scan put into cell `local` (gatherTile's), and where they start.
-std::pair<std::uint32_t, std::uint32_t> hitsOf(unsigned local, const ColumnWork& work) {
-  if (work.hits.empty()) return {0, 0};
-  return {work.hits_per_cell[local], work.hits_per_cell[local + 1]};
-}
+/// A cell's hits: a run of gatherTile's list.
+struct HitRun {
+  const detail::TileHit* first;
+  const detail::TileHit* last;
+  bool empty() const { return first == last; }
+  const detail::TileHit* begin() const { return first; }
+  const detail::TileHit* end() const { return last; }
+};
+
+/// The hits of the cells a tile's update visits in increasing local order (gatherTile's list,
+/// sorted by cell, holds only cells the scan reached): each cell's start where the previous
+/// cell's end.
+class HitCursor {
+ public:
+  explicit HitCursor(const std::vector<detail::TileHit>& hits)
+      : next_(hits.data()), end_(hits.data() + hits.size()) {}
+  HitRun next(unsigned local) {
+    const detail::TileHit* first = next_;
+    while (next_ != end_ && next_->local == local) ++next_;
+    return {first, next_};
+  }
+
+ private:
+  const detail::TileHit* next_;
+  const detail::TileHit* end_;
+};
 
 /// What the scan saw in cell `local`: its free intervals and its hits, each joined.
-void scanColumn(unsigned local, float join_gap, ColumnWork& work) {
+void scanColumn(unsigned local, HitRun hits, float join_gap, ColumnWork& work) {
   work.free.clear();
   for (const auto& [scratch, part] : work.parts) scratch->appendFree(*part, local, work.free);
   if (work.parts.size() > 1) {
@@ -146,9 +173,7 @@ void scanColumn(unsigned local, float join_gap, ColumnWork& work) {
     detail::joinSorted(work.free, join_gap);
   }
   work.positive.clear();
-  const auto [first_hit, end_hit] = hitsOf(local, work);
-  for (std::uint32_t h = first_hit; h < end_hit; ++h) {
-    const detail::TileHit& hit = work.hits[h];
+  for (const detail::TileHit& hit : hits) {
     const double mass = static_cast<double>(hit.top) - hit.bottom;  // density 1 (eq. 5)
     if (!work.positive.empty() && detail::joins(work.positive.back().top, hit.bottom, join_gap)) {
       work.positive.back().top = std::max(work.positive.back().top, hit.top);
@@ -192,6 +217,19 @@ bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t num_ne
   return true;
 }
 
+/// addCoveredFreeSpace's commonest case, inline: one added volume within one negative volume
+/// (the same double sum). Returns false, changing nothing, in any other case.
+inline bool addFreeSpaceWithinVolume(const Volume& added, Volume* negative,
+                                     std::uint32_t num_negative) {
+  for (Volume& v : VolumeSpan{negative, num_negative}) {
+    if (v.top < added.top) continue;
+    if (v.bottom > added.bottom) return false;
+    v.mass = static_cast<float>(static_cast<double>(v.mass) + added.mass);
+    return true;
+  }
+  return false;
+}
+
 /// Merges the new volumes of the scan's scratches into the columns of tile `key`.
 void updateTile(detail::TileBlock& tile, std::uint64_t key,
                 const std::vector<detail::ScanScratch>& scratches, const ModelRules& rules,
@@ -206,27 +244,30 @@ void updateTile(detail::TileBlock& tile, std::uint64_t key,
                                         rules.clip_free_space_at_hits};
   const float join_gap = detail::joinGapOf(rules);
   const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
+  HitCursor hit_cursor(work.hits);
+  // With one thread's part, a cell's free space may be one interval read from it directly.
+  const auto* only_part = work.parts.size() == 1 ? &work.parts[0] : nullptr;
   for (std::size_t word = 0; word < std::size(work.reached); ++word) {
     for (std::uint64_t bits = work.reached[word]; bits != 0; bits &= bits - 1) {
       const auto local = static_cast<unsigned>(64 * word + detail::lowestBit(bits));
-      const bool held = tile.holds(local);
-      const auto [first_hit, end_hit] = hitsOf(local, work);
-      const bool has_hits = end_hit > first_hit;
-      const detail::ColumnRef existing = held ? tile.column(local) : detail::ColumnRef{};
+      const HitRun hits = hit_cursor.next(local);
+      const detail::ColumnRef existing = tile.column(local);
+      const bool held = !existing.empty();  // a tile holds only cells with volumes
       // The tile's own storage of this cell, changed in place where the lengths stay.
       Volume* stored = const_cast<Volume*>(existing.positive);
       ScanInterval single;
-      if (!has_hits && held && work.parts.size() == 1 &&
-          work.parts[0].first->singleFree(*work.parts[0].second, local, single)) {
+      if (hits.empty() && held && only_part != nullptr &&
+          only_part->first->singleFree(*only_part->second, local, single)) {
         // The commonest case without a vector in between: one free interval, no hit.
         const Volume added{single.bottom, single.top,
                            massOf(single, single.bottom, single.top, per_scan, unit_mass)};
-        if (addCoveredFreeSpace(VolumeRun(&added, 1), stored + existing.num_positive,
-                                existing.num_negative)) {
+        Volume* negative = stored + existing.num_positive;
+        if (addFreeSpaceWithinVolume(added, negative, existing.num_negative) ||
+            addCoveredFreeSpace(VolumeRun(&added, 1), negative, existing.num_negative)) {
           continue;
         }
       }
-      scanColumn(local, join_gap, work);
+      scanColumn(local, hits, join_gap, work);
       addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
       if (work.added.positive.empty() &&
           addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
