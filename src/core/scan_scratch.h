@@ -96,8 +96,10 @@ class ScanScratch {
         tile.markReached(local);
         return;
       }
+      // A slot without other intervals has none below or above to reach (they are infinite).
       if (std::max(volume.bottom - slot.top, slot.bottom - volume.top) <= join_gap_ &&
-          std::min(volume.bottom - slot.below, slot.above - volume.top) > join_gap_) {
+          (slot.others == kNoOthers ||
+           std::min(volume.bottom - slot.below, slot.above - volume.top) > join_gap_)) {
         slot.bottom = std::min(slot.bottom, volume.bottom);
         slot.top = std::max(slot.top, volume.top);
         if (kCountMasses) tile.masses[local] += volume.mass;
@@ -117,7 +119,7 @@ class ScanScratch {
       const std::int32_t tx = cell.x >> kTileSizeLog2;
       const std::int32_t ty = cell.y >> kTileSizeLog2;
       // Consecutive cells of a ray mostly share a tile.
-      if (tile_ == nullptr || tx != x_ || ty != y_) {
+      if (tx != x_ || ty != y_) {
         tile_ = &scratch_.findOrAddTile(tx, ty);
         x_ = tx;
         y_ = ty;
@@ -129,7 +131,8 @@ class ScanScratch {
     const std::uint32_t stamp_;
     const float join_gap_;
     ScratchTile* tile_ = nullptr;
-    std::int32_t x_ = 0;
+    // No tile yet: no cell within MapConfig's bounds (2^22 cells) is in tile x = INT32_MIN.
+    std::int32_t x_ = std::numeric_limits<std::int32_t>::min();
     std::int32_t y_ = 0;
   };
 
