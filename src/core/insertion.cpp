@@ -230,6 +230,48 @@ inline bool addFreeSpaceWithinVolume(const Volume& added, Volume* negative,
   return false;
 }
 
+/// Merges what the scan saw in cell `local` of a tile (`hits`, and its scratches' free space)
+/// into the cell's lists `existing`, in place where their lengths stay, else into the tile's
+/// rewrite. Out of line: the loop over a tile's cells then keeps the commonest case's values in
+/// registers.
+[[gnu::noinline]] void updateColumn(unsigned local, HitRun hits, const detail::ColumnRef& existing,
+                                    const ModelRules& rules, float unit_mass, CellIndex origin,
+                                    ColumnWork& work) {
+  Volume* stored = const_cast<Volume*>(existing.positive);
+  scanColumn(local, hits, detail::joinGapOf(rules), work);
+  addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
+  if (work.added.positive.empty() &&
+      addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
+                          existing.num_negative)) {
+    return;
+  }
+  work.existing_positive.assign(existing.positive, existing.positive + existing.num_positive);
+  work.existing_negative.assign(existing.negative, existing.negative + existing.num_negative);
+  if (work.added.positive.empty()) {
+    work.merged.positive = work.existing_positive;
+  } else {
+    work.merger.merge(work.existing_positive, work.added.positive, {}, {}, unit_mass,
+                      work.merged.positive);
+  }
+  work.merger.merge(work.existing_negative, work.added.negative, work.merged.positive,
+                    {rules.split_free_space_at_obstacles, rules.clip_free_space_at_hits}, unit_mass,
+                    work.merged.negative);
+  const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
+  const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());
+  if (!existing.empty() && num_positive == existing.num_positive &&
+      num_negative == existing.num_negative) {
+    // Mostly every list keeps its length (new volumes merge into those there).
+    std::copy(work.merged.positive.begin(), work.merged.positive.end(), stored);
+    std::copy(work.merged.negative.begin(), work.merged.negative.end(), stored + num_positive);
+    return;
+  }
+  work.rewrite.set(local, work.merged.positive, work.merged.negative);
+  if (existing.empty() && num_positive + num_negative > 0) {
+    work.grown.extend(CellIndex{origin.x + static_cast<std::int32_t>(local % detail::kTileSize),
+                                origin.y + static_cast<std::int32_t>(local / detail::kTileSize)});
+  }
+}
+
 /// Merges the new volumes of the scan's scratches into the columns of tile `key`.
 void updateTile(detail::TileBlock& tile, std::uint64_t key,
                 const std::vector<detail::ScanScratch>& scratches, const ModelRules& rules,
@@ -240,9 +282,6 @@ void updateTile(detail::TileBlock& tile, std::uint64_t key,
   if (rescale != 1.0) tile.scaleMasses(rescale, exponent);
   work.rewrite.clear();
   const CellIndex origin = detail::tileOrigin(key);
-  const FreeSpaceRules free_space_rules{rules.split_free_space_at_obstacles,
-                                        rules.clip_free_space_at_hits};
-  const float join_gap = detail::joinGapOf(rules);
   const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
   HitCursor hit_cursor(work.hits);
   // With one thread's part, a cell's free space may be one interval read from it directly.
@@ -252,52 +291,20 @@ void updateTile(detail::TileBlock& tile, std::uint64_t key,
       const auto local = static_cast<unsigned>(64 * word + detail::lowestBit(bits));
       const HitRun hits = hit_cursor.next(local);
       const detail::ColumnRef existing = tile.column(local);
-      const bool held = !existing.empty();  // a tile holds only cells with volumes
-      // The tile's own storage of this cell, changed in place where the lengths stay.
-      Volume* stored = const_cast<Volume*>(existing.positive);
       ScanInterval single;
-      if (hits.empty() && held && only_part != nullptr &&
+      if (hits.empty() && !existing.empty() && only_part != nullptr &&
           only_part->first->singleFree(*only_part->second, local, single)) {
-        // The commonest case without a vector in between: one free interval, no hit.
+        // The commonest case without a vector in between: one free interval, no hit, changed
+        // in the tile's own storage.
         const Volume added{single.bottom, single.top,
                            massOf(single, single.bottom, single.top, per_scan, unit_mass)};
-        Volume* negative = stored + existing.num_positive;
+        Volume* negative = const_cast<Volume*>(existing.negative);
         if (addFreeSpaceWithinVolume(added, negative, existing.num_negative) ||
             addCoveredFreeSpace(VolumeRun(&added, 1), negative, existing.num_negative)) {
           continue;
         }
       }
-      scanColumn(local, hits, join_gap, work);
-      addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
-      if (work.added.positive.empty() &&
-          addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
-                              existing.num_negative)) {
-        continue;
-      }
-      work.existing_positive.assign(existing.positive, existing.positive + existing.num_positive);
-      work.existing_negative.assign(existing.negative, existing.negative + existing.num_negative);
-      if (work.added.positive.empty()) {
-        work.merged.positive = work.existing_positive;
-      } else {
-        work.merger.merge(work.existing_positive, work.added.positive, {}, {}, unit_mass,
-                          work.merged.positive);
-      }
-      work.merger.merge(work.existing_negative, work.added.negative, work.merged.positive,
-                        free_space_rules, unit_mass, work.merged.negative);
-      const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
-      const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());
-      if (held && num_positive == existing.num_positive && num_negative == existing.num_negative) {
-        // Mostly every list keeps its length (new volumes merge into those there).
-        std::copy(work.merged.positive.begin(), work.merged.positive.end(), stored);
-        std::copy(work.merged.negative.begin(), work.merged.negative.end(), stored + num_positive);
-        continue;
-      }
-      work.rewrite.set(local, work.merged.positive, work.merged.negative);
-      if (existing.empty() && num_positive + num_negative > 0) {
-        work.grown.extend(
-            CellIndex{origin.x + static_cast<std::int32_t>(local % detail::kTileSize),
-                      origin.y + static_cast<std::int32_t>(local / detail::kTileSize)});
-      }
+      updateColumn(local, hits, existing, rules, unit_mass, origin, work);
     }
   }
   if (work.rewrite.empty()) {
