@@ -147,6 +147,33 @@ void TileBlock::Builder::add(unsigned local, const std::vector<Volume>& positive
   volumes_.insert(volumes_.end(), negative.begin(), negative.end());
 }
 
+TileBlock TileBlock::allocate(std::uint32_t num_cells, std::uint32_t num_volumes, bool wide,
+                              std::int32_t exponent, std::uint64_t modified_revision) {
+  const std::size_t offset = volumesOffset(num_cells, wide);
+  void* memory = std::malloc(offset + std::size_t{num_volumes} * sizeof(Volume));
+  if (memory == nullptr) throw std::bad_alloc();
+  TileBlock tile;
+  tile.block_ = static_cast<Header*>(memory);
+  Header& header = *tile.block_;
+  std::memset(header.occupied, 0, sizeof(header.occupied));
+  header.modified_revision = modified_revision;
+  header.exponent = exponent;
+  header.num_volumes = num_volumes;
+  header.num_cells = static_cast<std::uint16_t>(num_cells);
+  header.volumes_offset = static_cast<std::uint16_t>(offset);
+  header.wide = wide ? 1 : 0;
+  header.lightest_mass = kUnknownMass;
+  return tile;
+}
+
+void TileBlock::countWordsBefore() {
+  unsigned before = 0;
+  for (unsigned w = 0; w + 1 < kCellsPerTile / 64; ++w) {
+    before += bitCount(block_->occupied[w]);
+    block_->words_before[w] = static_cast<std::uint8_t>(before);  // at most 192
+  }
+}
+
 TileBlock TileBlock::Builder::finish(std::int32_t exponent, std::uint64_t modified_revision) {
   TileBlock tile;
   const auto num_cells = static_cast<std::uint32_t>(locals_.size());
@@ -155,29 +182,14 @@ TileBlock TileBlock::Builder::finish(std::int32_t exponent, std::uint64_t modifi
     const bool wide = num_volumes > std::numeric_limits<std::uint16_t>::max() ||
                       *std::max_element(num_positive_.begin(), num_positive_.end()) >
                           std::numeric_limits<std::uint8_t>::max();
-    const std::size_t offset = volumesOffset(num_cells, wide);
-    void* memory = std::malloc(offset + std::size_t{num_volumes} * sizeof(Volume));
-    if (memory == nullptr) throw std::bad_alloc();
-    tile.block_ = static_cast<Header*>(memory);
+    tile = allocate(num_cells, num_volumes, wide, exponent, modified_revision);
     Header& header = *tile.block_;
-    std::memset(header.occupied, 0, sizeof(header.occupied));
-    header.modified_revision = modified_revision;
-    header.exponent = exponent;
-    header.num_volumes = num_volumes;
-    header.num_cells = static_cast<std::uint16_t>(num_cells);
-    header.volumes_offset = static_cast<std::uint16_t>(offset);
-    header.wide = wide ? 1 : 0;
-    header.lightest_mass = kUnknownMass;
     auto* base = reinterpret_cast<unsigned char*>(tile.block_ + 1);
     starts_.push_back(num_volumes);
     for (std::uint32_t r = 0; r < num_cells; ++r) {
       header.occupied[locals_[r] >> 6] |= std::uint64_t{1} << (locals_[r] & 63);
     }
-    unsigned before = 0;
-    for (unsigned w = 0; w + 1 < kCellsPerTile / 64; ++w) {
-      before += bitCount(header.occupied[w]);
-      header.words_before[w] = static_cast<std::uint8_t>(before);  // at most 192
-    }
+    tile.countWordsBefore();
     for (std::uint32_t r = 0; r <= num_cells; ++r) {
       if (wide) {
         std::memcpy(base + 4 * std::size_t{r}, &starts_[r], 4);
@@ -194,7 +206,7 @@ TileBlock TileBlock::Builder::finish(std::int32_t exponent, std::uint64_t modifi
       }
     }
     if (num_volumes > 0) {
-      std::memcpy(static_cast<unsigned char*>(memory) + offset, volumes_.data(),
+      std::memcpy(const_cast<Volume*>(tile.volumes()), volumes_.data(),
                   std::size_t{num_volumes} * sizeof(Volume));
     }
   }
@@ -221,6 +233,8 @@ void TileBlock::Rewrite::set(unsigned local, const std::vector<Volume>& positive
 
 TileBlock TileBlock::Rewrite::apply(const TileBlock& tile, std::int32_t exponent,
                                     std::uint64_t modified_revision) {
+  TileBlock narrow = applyNarrow(tile, exponent, modified_revision);
+  if (!narrow.empty()) return narrow;
   unsigned next_local = 0;
   for (const Cell& cell : cells_) {
     builder_.addUnchanged(tile, next_local, cell.local);
@@ -233,6 +247,74 @@ TileBlock TileBlock::Rewrite::apply(const TileBlock& tile, std::int32_t exponent
   }
   builder_.addUnchanged(tile, next_local, kCellsPerTile);
   return builder_.finish(exponent, modified_revision);
+}
+
+TileBlock TileBlock::Rewrite::applyNarrow(const TileBlock& tile, std::int32_t exponent,
+                                          std::uint64_t modified_revision) const {
+  if (!tile.empty() && tile.block_->wide != 0) return {};
+  // The new tile's size and bitmap.
+  std::uint32_t num_cells = tile.numCells();
+  std::uint32_t num_volumes = tile.numVolumes();
+  std::uint64_t occupied[kCellsPerTile / 64] = {};
+  if (!tile.empty()) std::memcpy(occupied, tile.block_->occupied, sizeof(occupied));
+  for (const Cell& cell : cells_) {
+    const std::uint64_t bit = std::uint64_t{1} << (cell.local & 63);
+    if (tile.holds(cell.local)) {
+      const ColumnRef old = tile.column(cell.local);
+      --num_cells;
+      num_volumes -= old.num_positive + old.num_negative;
+      occupied[cell.local >> 6] &= ~bit;
+    }
+    if (cell.num_positive + cell.num_negative == 0) continue;
+    if (cell.num_positive > std::numeric_limits<std::uint8_t>::max()) return {};
+    ++num_cells;
+    num_volumes += cell.num_positive + cell.num_negative;
+    occupied[cell.local >> 6] |= bit;
+  }
+  if (num_cells == 0 || num_volumes > std::numeric_limits<std::uint16_t>::max()) return {};
+
+  TileBlock result = allocate(num_cells, num_volumes, false, exponent, modified_revision);
+  std::memcpy(result.block_->occupied, occupied, sizeof(occupied));
+  result.countWordsBefore();
+  auto* starts = reinterpret_cast<unsigned char*>(result.block_ + 1);
+  unsigned char* counts = starts + 2 * (std::size_t{num_cells} + 1);
+  auto* volumes = const_cast<Volume*>(result.volumes());
+  std::uint32_t rank = 0;     // the new tile's cells written
+  std::uint32_t written = 0;  // and volumes
+  auto write_start = [&](std::uint32_t at, std::uint32_t start) {
+    const auto value = static_cast<std::uint16_t>(start);
+    std::memcpy(starts + 2 * std::size_t{at}, &value, 2);
+  };
+  // The old cells of ranks [first_rank, end_rank), unchanged: their volumes are one run.
+  auto copy_unchanged = [&](unsigned first_rank, unsigned end_rank) {
+    if (first_rank == end_rank) return;
+    const std::uint32_t first = tile.start(first_rank);
+    const std::uint32_t count = tile.start(end_rank) - first;
+    std::memcpy(volumes + written, tile.volumes() + first, std::size_t{count} * sizeof(Volume));
+    for (unsigned r = first_rank; r < end_rank; ++r) {
+      write_start(rank, tile.start(r) - first + written);
+      counts[rank++] = static_cast<unsigned char>(tile.positiveCount(r));
+    }
+    written += count;
+  };
+  unsigned old_rank = 0;  // the next old cell not yet passed
+  for (const Cell& cell : cells_) {
+    if (!tile.empty()) {
+      const unsigned below = tile.rank(cell.local);
+      copy_unchanged(old_rank, below);
+      old_rank = below + (tile.holds(cell.local) ? 1 : 0);
+    }
+    const std::uint32_t count = cell.num_positive + cell.num_negative;
+    if (count == 0) continue;
+    std::memcpy(volumes + written, volumes_.data() + cell.start,
+                std::size_t{count} * sizeof(Volume));
+    write_start(rank, written);
+    counts[rank++] = static_cast<unsigned char>(cell.num_positive);
+    written += count;
+  }
+  copy_unchanged(old_rank, tile.numCells());
+  write_start(num_cells, written);
+  return result;
 }
 
 }  // namespace detail

@@ -162,6 +162,12 @@ class TileBlock {
       std::uint32_t num_positive;
       std::uint32_t num_negative;
     };
+    /// apply() for the tiles whose old and new entries are narrow (nearly all): one pass that
+    /// writes the new tile, runs of unchanged cells copied whole. Empty if the new tile would
+    /// be wide or the old one is.
+    TileBlock applyNarrow(const TileBlock& tile, std::int32_t exponent,
+                          std::uint64_t modified_revision) const;
+
     std::vector<Cell> cells_;
     std::vector<Volume> volumes_;
     Builder builder_;
@@ -189,6 +195,12 @@ class TileBlock {
   std::uint32_t positiveCount(unsigned rank) const;
   const Volume* volumes() const;
   static std::size_t volumesOffset(std::uint32_t num_cells, bool wide);
+  /// A tile of `num_cells` cells and `num_volumes` volumes, its header written with an empty
+  /// bitmap: the caller sets the bitmap, then calls countWordsBefore, and writes the entries and
+  /// volumes.
+  static TileBlock allocate(std::uint32_t num_cells, std::uint32_t num_volumes, bool wide,
+                            std::int32_t exponent, std::uint64_t modified_revision);
+  void countWordsBefore();
 
   Header* block_ = nullptr;
 };
