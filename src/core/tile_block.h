@@ -163,8 +163,8 @@ class TileBlock {
       std::uint32_t num_negative;
     };
     /// apply() for the tiles whose old and new entries are narrow (nearly all): one pass that
-    /// writes the new tile, runs of unchanged cells copied whole. Empty if the new tile would
-    /// be wide or the old one is.
+    /// writes the new tile, runs of unchanged cells copied whole. Empty, for the builder to do,
+    /// if the old tile or the new one is wide, or if no cell is left.
     TileBlock applyNarrow(const TileBlock& tile, std::int32_t exponent,
                           std::uint64_t modified_revision) const;
 
