@@ -492,13 +492,16 @@ class BadInput(unittest.TestCase):
                  ("frontier_min_z", {"frontier_min_z": 2.0, "frontier_max_z": 1.0}),
                  ("depth_stride", {"depth_stride": 0}),
                  ("autosave_period", {"autosave_period": -5.0})]
-        for k, (parameter, values) in enumerate(cases):
-            server = rel.Server("mapper_refused_%d" % k, values)
-            try:
-                status = server.wait_exit()
-                output = server.output()
-            finally:
+        # All started at once: each only reads its parameters and exits.
+        servers = []
+        try:
+            for k, (_, values) in enumerate(cases):
+                servers.append(rel.Server("mapper_refused_%d" % k, values))
+            outcomes = [(server.wait_exit(), server.output()) for server in servers]
+        finally:
+            for server in servers:
                 server.stop()
+        for (parameter, values), (status, output) in zip(cases, outcomes):
             self.assertNotEqual(status, 0, "%s: %s" % (values, output))
             self.assertIn("~" + parameter, output, values)
             line = [l for l in output.splitlines() if "cannot start" in l]
