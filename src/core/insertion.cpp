@@ -73,8 +73,8 @@ struct ColumnWork {
   ListMerger merger;
   /// The scratches that reached the tile being updated, and their part of it.
   std::vector<std::pair<const detail::ScanScratch*, const detail::ScratchTile*>> parts;
-  std::vector<detail::TileHit> hits;  // the tile's, by cell (gatherTile)
-  std::vector<detail::TileHit> sorted_hits;
+  std::vector<detail::TileHit> hits;                  // the tile's, by cell (gatherTile)
+  std::vector<detail::TileHit> sorted_hits;           // gatherTile's counting sort's output
   std::uint64_t reached[detail::kCellsPerTile / 64];  // the cells the scan reached
   std::vector<ScanInterval> free;
   std::vector<ScanInterval> positive;
@@ -184,11 +184,10 @@ void scanColumn(unsigned local, HitRun hits, float join_gap, ColumnWork& work) {
   }
 }
 
-/// The commonest update by far once a place has been seen: free space where the column already
-/// holds free space, and no hit. The lists keep their volumes and bounds; each negative volume
-/// gains the mass that falls within it (what ListMerger gives: no gap closes, no obstacle is
-/// newly reached, so its pieces stay). Returns false, changing nothing, in any other case.
-bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t num_negative) {
+/// addCoveredFreeSpace when an added volume is not within one negative volume: each added volume
+/// must lie within one run of touching negative volumes, among which its mass is shared.
+[[gnu::noinline]] bool addSpanningFreeSpace(VolumeRun added, Volume* negative,
+                                            std::uint32_t num_negative) {
   if (num_negative == 0) return false;
   // Every added volume lies within one run of touching negative volumes.
   for (const Volume& a : added) {
@@ -217,17 +216,22 @@ bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t num_ne
   return true;
 }
 
-/// addCoveredFreeSpace's commonest case, inline: one added volume within one negative volume
-/// (the same double sum). Returns false, changing nothing, in any other case.
-inline bool addFreeSpaceWithinVolume(const Volume& added, Volume* negative,
-                                     std::uint32_t num_negative) {
-  for (Volume& v : VolumeSpan{negative, num_negative}) {
-    if (v.top < added.top) continue;
-    if (v.bottom > added.bottom) return false;
-    v.mass = static_cast<float>(static_cast<double>(v.mass) + added.mass);
-    return true;
+/// The commonest update by far once a place has been seen: free space where the column already
+/// holds free space, and no hit. The lists keep their volumes and bounds; each negative volume
+/// gains the mass that falls within it (what ListMerger gives: no gap closes, no obstacle is
+/// newly reached, so its pieces stay). Returns false, changing nothing, in any other case.
+inline bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t num_negative) {
+  if (added.size == 1) {
+    // Mostly one added volume within one negative volume: its mass added there, inline (the
+    // same double sum as below).
+    for (Volume& v : VolumeSpan{negative, num_negative}) {
+      if (v.top < added.data[0].top) continue;
+      if (v.bottom > added.data[0].bottom) break;
+      v.mass = static_cast<float>(static_cast<double>(v.mass) + added.data[0].mass);
+      return true;
+    }
   }
-  return false;
+  return addSpanningFreeSpace(added, negative, num_negative);
 }
 
 /// Merges what the scan saw in cell `local` of a tile (`hits`, and its scratches' free space)
@@ -299,8 +303,7 @@ void updateTile(detail::TileBlock& tile, std::uint64_t key,
         const Volume added{single.bottom, single.top,
                            massOf(single, single.bottom, single.top, per_scan, unit_mass)};
         Volume* negative = const_cast<Volume*>(existing.negative);
-        if (addFreeSpaceWithinVolume(added, negative, existing.num_negative) ||
-            addCoveredFreeSpace(VolumeRun(&added, 1), negative, existing.num_negative)) {
+        if (addCoveredFreeSpace(VolumeRun(&added, 1), negative, existing.num_negative)) {
           continue;
         }
       }

@@ -113,27 +113,17 @@ void TileBlock::Builder::addUnchanged(const TileBlock& tile, unsigned first, uns
   const unsigned first_rank = r;
   const auto shift = static_cast<std::int64_t>(volumes_.size()) -
                      static_cast<std::int64_t>(r < header.num_cells ? tile.start(r) : 0);
-  const unsigned end_rank = end < kCellsPerTile ? tile.rank(end) : header.num_cells;
-  if (end_rank == first_rank) return;
-  // The cells' entries written in place (this copies most of a tile whenever it is rebuilt).
-  const std::size_t at = locals_.size();
-  const std::size_t count = end_rank - first_rank;
-  locals_.resize(at + count);
-  starts_.resize(at + count);
-  num_positive_.resize(at + count);
-  std::uint16_t* local_out = locals_.data() + at;
   for (unsigned word = first >> 6; word < kCellsPerTile / 64 && 64 * word < end; ++word) {
     std::uint64_t bits = header.occupied[word];
     if (64 * word < first) bits &= ~std::uint64_t{0} << (first & 63);
     if (end < 64 * (word + 1)) bits &= (std::uint64_t{1} << (end & 63)) - 1;
-    for (; bits != 0; bits &= bits - 1) {
-      *local_out++ = static_cast<std::uint16_t>(64 * word + lowestBit(bits));
+    for (; bits != 0; bits &= bits - 1, ++r) {
+      locals_.push_back(static_cast<std::uint16_t>(64 * word + lowestBit(bits)));
+      starts_.push_back(static_cast<std::uint32_t>(tile.start(r) + shift));
+      num_positive_.push_back(tile.positiveCount(r));
     }
   }
-  for (; r < end_rank; ++r) {
-    starts_[at + r - first_rank] = static_cast<std::uint32_t>(tile.start(r) + shift);
-    num_positive_[at + r - first_rank] = tile.positiveCount(r);
-  }
+  if (r == first_rank) return;
   const Volume* from = tile.volumes() + tile.start(first_rank);
   volumes_.insert(volumes_.end(), from, tile.volumes() + tile.start(r));
 }

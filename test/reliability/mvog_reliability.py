@@ -1,7 +1,7 @@
 """Shared code of the reliability rostests (test/reliability/*.test).
 
-Each test node starts the mapping servers it needs itself (mvog_node as rosrun finds it, under its own
-name, with its own topics, parameters and temporary map directory), feeds them through rospy and
+Each test node starts the mapping servers it needs itself (mvog_node as rosrun finds it, under its
+own name, with its own topics, parameters and temporary map directory), feeds them through rospy and
 reads their ~statistics and services. Every wait is for a condition, with a generous timeout;
 nothing asserts how long anything took.
 """
