@@ -277,10 +277,11 @@ inline bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t
 }
 
 /// Merges the new volumes of the scan's scratches into the columns of tile `key`.
-void updateTile(detail::TileBlock& tile, std::uint64_t key,
-                const std::vector<detail::ScanScratch>& scratches, const ModelRules& rules,
-                float unit_mass, double rescale, std::int32_t exponent, std::uint64_t revision,
-                ColumnWork& work) {
+MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
+                                     const std::vector<detail::ScanScratch>& scratches,
+                                     const ModelRules& rules, float unit_mass, double rescale,
+                                     std::int32_t exponent, std::uint64_t revision,
+                                     ColumnWork& work) {
   gatherTile(key, scratches, work);
   // The tile was written before a decay step: bring its masses to the current unit first.
   if (rescale != 1.0) tile.scaleMasses(rescale, exponent);

@@ -12,6 +12,16 @@
 #include "mvog/cell_index.h"
 #include "mvog/volume.h"
 
+/// Compiles the function it marks twice, for the build's x86-64 level and for CPUs with the
+/// popcnt instruction (nearly every x86-64 CPU since 2008), and lets the loader pick one (GCC's
+/// and clang's function multiversioning). For the loops that find many columns by their rank in a
+/// tile's bitmap (bitCount), where the instruction replaces a dozen.
+#if defined(__x86_64__) && !defined(__POPCNT__) && (defined(__GNUC__) || defined(__clang__))
+#define MVOG_ALSO_FOR_POPCNT __attribute__((target_clones("popcnt", "default")))
+#else
+#define MVOG_ALSO_FOR_POPCNT
+#endif
+
 namespace mvog {
 namespace detail {
 
@@ -208,7 +218,8 @@ class TileBlock {
 // The accessors of every query and insertion, inline.
 
 /// Bits set in x, without a library call (the build targets no particular x86 level, where
-/// __builtin_popcountll calls libgcc).
+/// __builtin_popcountll calls libgcc). GCC and clang recognise this form: compiled for a CPU with
+/// popcnt, it is that one instruction (see MVOG_ALSO_FOR_POPCNT).
 inline unsigned bitCount(std::uint64_t x) {
   x = x - ((x >> 1) & 0x5555555555555555ull);
   x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
