@@ -198,22 +198,16 @@ bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, Re
   return true;
 }
 
-/// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`
-/// (a copy of the chunk's writer, local to the ray so that the walk keeps it in registers).
-template <class Writer>
-void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
-                bool model_negative_space, Writer scratch) {
+/// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`,
+/// each cell's free volume from `free_volume(z_enter, z_exit)`.
+template <class Writer, class FreeVolume>
+void walkReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
+                 Writer& scratch, const FreeVolume& free_volume) {
   const auto end_z = static_cast<float>(end.z());
-  if (!model_negative_space) {
-    // Only the obstacle's own volume, in the cell the walk would end in (see walkRay): no walk.
-    if (obstacle) scratch.addHit(cellAt(end.x(), end.y()), makeVolume(end_z - 0.5f, end_z + 0.5f));
-    return;
-  }
   walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
           [&](const CellIndex& cell, double z_enter, double z_exit, bool is_last) {
             if (!is_last || !obstacle) {  // eqs. (3) and (4)
-              scratch.addFree(cell,
-                              makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
+              scratch.addFree(cell, free_volume(z_enter, z_exit));
               return;
             }
             const Volume positive = makeVolume(end_z - 0.5f, end_z + 0.5f);  // eq. (5)
@@ -223,6 +217,29 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
                                                z_enter < end.z() ? positive.bottom : positive.top));
             }
           });
+}
+
+/// The volumes of one reading (see walkReading), into `scratch` (a copy of the chunk's writer,
+/// local to the ray so that the walk keeps it in registers).
+template <class Writer>
+void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
+                bool model_negative_space, Writer scratch) {
+  const auto end_z = static_cast<float>(end.z());
+  if (!model_negative_space) {
+    // Only the obstacle's own volume, in the cell the walk would end in (see walkRay): no walk.
+    if (obstacle) scratch.addHit(cellAt(end.x(), end.y()), makeVolume(end_z - 0.5f, end_z + 0.5f));
+    return;
+  }
+  if (start.z() == end.z()) {
+    // A level ray (a 2D laser's): it enters and leaves every cell at its one height, so eq. (6)
+    // gives every cell the same free volume, made once instead of in each cell.
+    const Volume level = makeVolume(end_z, end_z);
+    walkReading(start, end, obstacle, scratch, [&](double, double) { return level; });
+    return;
+  }
+  walkReading(start, end, obstacle, scratch, [](double z_enter, double z_exit) {
+    return makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit));
+  });
 }
 
 /// The readings of `scan` (its hits, then its out-of-range readings) that `mine(k)` gives to
