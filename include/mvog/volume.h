@@ -38,9 +38,24 @@ inline bool mustMerge(float lower_top, float upper_bottom) {
   return upper_bottom - lower_top <= kMaxMergeGap;
 }
 
+/// A volume from `bottom` to `top` of at least kMinVolumeHeight: the float sums of eq. (6) may
+/// round to just under the minimum height. Then the top is raised to bottom + 1, and one float
+/// further if that sum rounds down too (then it lies above it). Nudging the top up one float at a
+/// time until the height is 1, as before, could take billions of steps when the top lies just
+/// below zero (found by fuzzing). Its mass is that of density 1 over its final height: every new
+/// volume starts at density 1 (Sec. III-B.2).
+inline Volume volumeOfMinimumHeight(float bottom, float top) {
+  Volume volume{bottom, top, 0.0f};
+  if (volume.height() < kMinVolumeHeight) {
+    volume.top = std::max(volume.top, volume.bottom + kMinVolumeHeight);
+    if (volume.height() < kMinVolumeHeight) volume.top = std::nextafter(volume.top, INFINITY);
+  }
+  volume.mass = volume.height();
+  return volume;
+}
+
 /// Eq. (6): the volume spanning [z_a, z_b] (either order) with the minimum height enforced around
-/// its centre. Its mass is that of density 1 over its final height: every new volume starts at
-/// density 1 (Sec. III-B.2).
+/// its centre.
 inline Volume makeVolume(float z_a, float z_b) {
   const float low = std::min(z_a, z_b);
   const float high = std::max(z_a, z_b);
@@ -48,18 +63,14 @@ inline Volume makeVolume(float z_a, float z_b) {
   // than 1 follows no pattern a branch predictor could learn, and this runs for every cell.
   const float centre = 0.5f * (low + high);  // eq. (6)
   const bool lift = high - low < kMinVolumeHeight;
-  Volume volume{lift ? centre - 0.5f * kMinVolumeHeight : low,
-                lift ? centre + 0.5f * kMinVolumeHeight : high, 0.0f};
-  // The float sums may round to just under the minimum height. Then raise the top to bottom + 1,
-  // and one float further if that sum rounds down too (then it lies above it). Nudging the top up
-  // one float at a time until the height is 1, as before, could take billions of steps when the
-  // top lies just below zero (found by fuzzing).
-  if (volume.height() < kMinVolumeHeight) {
-    volume.top = std::max(volume.top, volume.bottom + kMinVolumeHeight);
-    if (volume.height() < kMinVolumeHeight) volume.top = std::nextafter(volume.top, INFINITY);
-  }
-  volume.mass = volume.height();
-  return volume;
+  return volumeOfMinimumHeight(lift ? centre - 0.5f * kMinVolumeHeight : low,
+                               lift ? centre + 0.5f * kMinVolumeHeight : high);
+}
+
+/// makeVolume(z_a, z_b) for a span known to be lower than kMinVolumeHeight, from its centre
+/// 0.5f * (z_a + z_b).
+inline Volume makeVolumeAround(float centre) {
+  return volumeOfMinimumHeight(centre - 0.5f * kMinVolumeHeight, centre + 0.5f * kMinVolumeHeight);
 }
 
 /// The volume of `list[0, count)` that contains height z, or nullptr.

@@ -198,6 +198,10 @@ bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, Re
   return true;
 }
 
+/// The heights (grid units) below which a float is within 1/32 of the double it rounds: two
+/// heights half a cell apart stay less than a cell apart as floats.
+constexpr double kShallowRayMaxHeight = 1 << 20;
+
 /// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`,
 /// each cell's free volume from `free_volume(z_enter, z_exit)`.
 template <class Writer, class FreeVolume>
@@ -235,6 +239,18 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
     // gives every cell the same free volume, made once instead of in each cell.
     const Volume level = makeVolume(end_z, end_z);
     walkReading(start, end, obstacle, scratch, [&](double, double) { return level; });
+    return;
+  }
+  // Eq. (6) lifts a crossing lower than one cell around its centre. A ray that rises at most half
+  // a cell per cell along its main axis crosses every cell lower than that (it spends at most
+  // 1 / max(|dx|, |dy|) of its length in a cell), even after rounding its heights to floats
+  // below kShallowRayMaxHeight: then every crossing is lifted, with no test in each cell.
+  const Eigen::Vector3d ray = end - start;
+  if (std::fabs(ray.z()) <= 0.5 * std::max(std::fabs(ray.x()), std::fabs(ray.y())) &&
+      std::max(std::fabs(start.z()), std::fabs(end.z())) < kShallowRayMaxHeight) {
+    walkReading(start, end, obstacle, scratch, [](double z_enter, double z_exit) {
+      return makeVolumeAround(0.5f * (static_cast<float>(z_enter) + static_cast<float>(z_exit)));
+    });
     return;
   }
   walkReading(start, end, obstacle, scratch, [](double z_enter, double z_exit) {

@@ -672,40 +672,43 @@ TEST(Insertion, EveryRuleSetEqualsThePlainReference) {
   }
 }
 
-/// Scans of a planar laser at `height` (m) from `origin`'s xy: `beams` level readings over 360
-/// degrees at random ranges up to 6 m, every fifth without a return, and every seventh tilted
-/// off level by `tilt` (m at its end).
+/// A scan of a planar laser at `height` (m) from `origin`'s xy: `beams` level readings over 360
+/// degrees at random ranges up to 6 m, every fifth without a return, and every seventh rising by
+/// `rise` per metre along its main axis (x or y).
 Scan planarLaserScan(std::mt19937& rng, const Eigen::Vector2d& origin, double height, int beams,
-                     float tilt) {
+                     double rise) {
   Scan scan;
   scan.origin = {origin.x(), origin.y(), height};
   std::uniform_real_distribution<double> range(0.3, 6.0);
   for (int k = 0; k < beams; ++k) {
     const double angle = 2.0 * M_PI * k / beams;
-    Eigen::Vector3f end =
-        (scan.origin + range(rng) * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0))
-            .cast<float>();
-    end.z() = static_cast<float>(height) + (k % 7 == 0 ? tilt : 0.0f);
-    (k % 5 == 0 ? scan.out_of_range : scan.hits).push_back(end);
+    Eigen::Vector3d end =
+        scan.origin + range(rng) * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
+    if (k % 7 == 0) {
+      end.z() += rise * std::max(std::fabs(end.x() - origin.x()), std::fabs(end.y() - origin.y()));
+    }
+    (k % 5 == 0 ? scan.out_of_range : scan.hits).push_back(end.cast<float>());
   }
   return scan;
 }
 
-TEST(Insertion, LevelRaysEqualThePlainReference) {
-  // A 2D laser's rays are level: each enters and leaves every cell at one height. Beside them,
-  // rays tilted by a hair and by a cell. At heights on a cell boundary, just off it and far from
-  // it, with and without negative zero, the map must equal test::ReferenceModel, which makes
-  // every cell's volume from its entry and exit heights (eq. 6).
+TEST(Insertion, LevelAndShallowRaysEqualThePlainReference) {
+  // A 2D laser's rays are level: each enters and leaves every cell at one height. Rays that rise
+  // less than half a cell per cell cross every cell lower than one (eq. 6 lifts each crossing).
+  // Beside them, rays rising by a hair, by just under and just over half a cell a cell, and by
+  // more than a cell a cell (some crossings higher than one). At heights on a cell boundary, just
+  // off it and far from it, with and without negative zero, and near 2^20 cells, the map must equal
+  // test::ReferenceModel, which makes every cell's volume from its entry and exit heights (eq. 6).
   std::mt19937 rng(5);
   for (const ModelRules& rules : everyRuleSet()) {
     SCOPED_TRACE(describe(rules));
-    test::MapBesideReference maps(MapConfig{0.05, 10000.0, rules});
-    for (const double height : {0.3, 0.025, 0.02500001, -0.0, 1.7e-8, -2.4}) {
-      for (const float tilt : {0.0f, 1e-6f, 0.05f}) {
+    test::MapBesideReference maps(MapConfig{0.05, 60000.0, rules});
+    for (const double height : {0.3, 0.025, 0.02500001, -0.0, 1.7e-8, -2.4, 52428.0, -52429.0}) {
+      for (const double rise : {0.0, 1e-7, 0.499, 0.501, 1.5}) {
         const Eigen::Vector2d origin(std::uniform_real_distribution<double>(-1.0, 1.0)(rng),
                                      std::uniform_real_distribution<double>(-1.0, 1.0)(rng));
-        ASSERT_TRUE(maps.insert(planarLaserScan(rng, origin, height, 361, tilt)))
-            << "height " << height << ", tilt " << tilt;
+        ASSERT_TRUE(maps.insert(planarLaserScan(rng, origin, height, 121, rise)))
+            << "height " << height << ", rise " << rise;
       }
     }
     EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
