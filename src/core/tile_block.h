@@ -15,8 +15,19 @@
 /// Compiles the function it marks twice, for the build's x86-64 level and for CPUs with the
 /// popcnt instruction (nearly every x86-64 CPU since 2008), and lets the loader pick one (GCC's
 /// and clang's function multiversioning). For the loops that find many columns by their rank in a
-/// tile's bitmap (bitCount), where the instruction replaces a dozen.
-#if defined(__x86_64__) && !defined(__POPCNT__) && (defined(__GNUC__) || defined(__clang__))
+/// tile's bitmap (bitCount), where the instruction replaces a dozen. Not under ThreadSanitizer:
+/// the loader runs the clones' resolver before the sanitizer's runtime is up, and its
+/// instrumented code crashes there.
+#if defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define MVOG_THREAD_SANITIZER 1
+#endif
+#endif
+#if defined(__SANITIZE_THREAD__)
+#define MVOG_THREAD_SANITIZER 1
+#endif
+#if defined(__x86_64__) && !defined(__POPCNT__) && !defined(MVOG_THREAD_SANITIZER) && \
+    (defined(__GNUC__) || defined(__clang__))
 #define MVOG_ALSO_FOR_POPCNT __attribute__((target_clones("popcnt", "default")))
 #else
 #define MVOG_ALSO_FOR_POPCNT
