@@ -749,13 +749,23 @@ TEST_F(Mapper, PublishesMarkersAndGridsInTheMapFrame) {
   EXPECT_TRUE(projected_map.waitForMessage(showsTheSceneAtLaserHeight));
 
   // Further readings inside the grid arrive as updates: the laser scans again from elsewhere.
+  // The first scan's changes may be published together with the last clouds' that grew the grid
+  // (a grid laid out anew is sent whole, without an update), or before this subscription is
+  // connected (on a loaded machine): the laser then scans once more from the same place, well
+  // inside the grid.
   const std::size_t updates_before = projected_map_updates.size();
-  sensors_->publishMovingScan("/scan", 1.0);
-  server_->waitForInsertedMessages(kScans + kClouds + 1);
-  EXPECT_TRUE(projected_map_updates.waitForAll([&](const auto& all) {
+  const auto updated = [&](const auto& all) {
     return all.size() > updates_before && all.back()->header.frame_id == "map" &&
            all.back()->data.size() == std::size_t{all.back()->width} * all.back()->height;
-  }));
+  };
+  constexpr int kAttempts = 3;
+  bool received = false;
+  for (int attempt = 1; attempt <= kAttempts && !received; ++attempt) {
+    sensors_->publishMovingScan("/scan", 1.0);
+    server_->waitForInsertedMessages(kScans + kClouds + attempt);
+    received = projected_map_updates.waitForAll(updated);
+  }
+  EXPECT_TRUE(received);
 }
 
 TEST_F(Mapper, CutsCrossSectionsOnRequest) {
