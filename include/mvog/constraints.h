@@ -52,6 +52,12 @@ class ListMerger {
   void merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles, FreeSpaceRules rules,
              float unit_mass, std::vector<Volume>& out);
 
+  /// Whether merge(negative, {}, obstacles, rules, ...) would return `negative` (which satisfies
+  /// Sec. III-A) itself, bit for bit: each run of touching volumes is cut as the merge cuts it.
+  /// Cheaper than the merge: a column whose update only adds mass within its volumes is then
+  /// changed in place (the scan update's commonest case).
+  bool keepsUnchanged(VolumeRun negative, VolumeRun obstacles, FreeSpaceRules rules);
+
  private:
   /// A volume whose mass contributes to the merged list (its density is uniform over it).
   struct Source {
@@ -67,6 +73,9 @@ class ListMerger {
     std::size_t end_inside;
   };
   void sweep();
+  /// Appends the pieces of the component [bottom, top] cut at the obstacles within it.
+  static void cutAtObstacles(float bottom, float top, const Volume* first_obstacle,
+                             const Volume* end_obstacle, std::vector<Volume>& out);
   void addPieces(const Component& component, std::vector<Volume>& out) const;
   double massWithin(float bottom, float top) const;
 
@@ -76,6 +85,7 @@ class ListMerger {
   std::vector<Volume> inside_;         // the obstacles the free space reaches into
   std::vector<Volume> reached_;        // the same, as found by the last sweep
   std::vector<Component> components_;  // upwards
+  std::vector<Volume> pieces_;         // keepsUnchanged's cut of one run
 };
 
 }  // namespace mvog

@@ -109,36 +109,80 @@ void ListMerger::sweep() {
   }
 }
 
-void ListMerger::addPieces(const Component& component, std::vector<Volume>& out) const {
-  const std::size_t first_piece = out.size();
-  if (component.first_inside == component.end_inside) {
-    out.push_back({component.bottom, component.top, 0.0f});
-  } else {
-    // Cut at the obstacles' heights: outside, inside, outside, ... Obstacles lie more than
-    // kMaxMergeGap apart, so only a first or last outside piece can be too low: it joins its
-    // obstacle's piece.
-    float below = component.bottom;
-    for (std::size_t k = component.first_inside; k != component.end_inside; ++k) {
-      const Volume& obstacle = inside_[k];
-      if (obstacle.bottom > below &&
-          (k != component.first_inside || obstacle.bottom - below >= kMinVolumeHeight)) {
-        out.push_back({below, obstacle.bottom, 0.0f});
-        below = obstacle.bottom;
-      }
-      out.push_back({below, obstacle.top, 0.0f});
-      below = obstacle.top;
+void ListMerger::cutAtObstacles(float bottom, float top, const Volume* first_obstacle,
+                                const Volume* end_obstacle, std::vector<Volume>& out) {
+  if (first_obstacle == end_obstacle) {
+    out.push_back({bottom, top, 0.0f});
+    return;
+  }
+  // Cut at the obstacles' heights: outside, inside, outside, ... Obstacles lie more than
+  // kMaxMergeGap apart, so only a first or last outside piece can be too low: it joins its
+  // obstacle's piece.
+  float below = bottom;
+  for (const Volume* obstacle = first_obstacle; obstacle != end_obstacle; ++obstacle) {
+    if (obstacle->bottom > below &&
+        (obstacle != first_obstacle || obstacle->bottom - below >= kMinVolumeHeight)) {
+      out.push_back({below, obstacle->bottom, 0.0f});
+      below = obstacle->bottom;
     }
-    if (below < component.top) {
-      if (component.top - below < kMinVolumeHeight) {
-        out.back().top = component.top;
-      } else {
-        out.push_back({below, component.top, 0.0f});
-      }
+    out.push_back({below, obstacle->top, 0.0f});
+    below = obstacle->top;
+  }
+  if (below < top) {
+    if (top - below < kMinVolumeHeight) {
+      out.back().top = top;
+    } else {
+      out.push_back({below, top, 0.0f});
     }
   }
+}
+
+void ListMerger::addPieces(const Component& component, std::vector<Volume>& out) const {
+  const std::size_t first_piece = out.size();
+  cutAtObstacles(component.bottom, component.top, inside_.data() + component.first_inside,
+                 inside_.data() + component.end_inside, out);
   for (std::size_t k = first_piece; k < out.size(); ++k) {
     out[k].mass = static_cast<float>(massWithin(out[k].bottom, out[k].top));
   }
+}
+
+bool ListMerger::keepsUnchanged(VolumeRun negative, VolumeRun obstacles, FreeSpaceRules rules) {
+  if (!rules.split_at_obstacles) obstacles = {};
+  std::size_t next_obstacle = 0;
+  for (std::size_t first = 0; first < negative.size;) {
+    // A run of volumes the sweep joins into one component: in a list that satisfies Sec. III-A,
+    // volumes that touch (no gap of kMaxMergeGap or less lies between two).
+    std::size_t end = first + 1;
+    while (end < negative.size && negative.data[end].bottom == negative.data[end - 1].top) ++end;
+    const float bottom = negative.data[first].bottom;
+    const float top = negative.data[end - 1].top;
+    // The obstacles the run reaches into must lie within it, else they widen its component.
+    while (next_obstacle < obstacles.size && obstacles.data[next_obstacle].top <= bottom) {
+      ++next_obstacle;
+    }
+    std::size_t end_obstacle = next_obstacle;
+    for (; end_obstacle < obstacles.size && obstacles.data[end_obstacle].bottom < top;
+         ++end_obstacle) {
+      if (obstacles.data[end_obstacle].bottom < bottom || obstacles.data[end_obstacle].top > top) {
+        return false;
+      }
+    }
+    // And the run's volumes must be the pieces the merge would cut: each is then one source,
+    // whose mass it keeps.
+    pieces_.clear();
+    cutAtObstacles(bottom, top, obstacles.data + next_obstacle, obstacles.data + end_obstacle,
+                   pieces_);
+    const auto same_bounds = [](const Volume& a, const Volume& b) {
+      return a.bottom == b.bottom && a.top == b.top;
+    };
+    if (!std::equal(pieces_.begin(), pieces_.end(), negative.data + first, negative.data + end,
+                    same_bounds)) {
+      return false;
+    }
+    next_obstacle = end_obstacle;
+    first = end;
+  }
+  return true;
 }
 
 double ListMerger::massWithin(float bottom, float top) const {

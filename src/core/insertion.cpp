@@ -234,6 +234,43 @@ inline bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t
   return addSpanningFreeSpace(added, negative, num_negative);
 }
 
+/// The commonest update of a column with hits once its surface has been seen: each hit within a
+/// positive volume of its own, the free space (if any) within the negative list's runs, and a
+/// negative list that the merge keeps as it is (ListMerger::keepsUnchanged). What ListMerger
+/// gives then: no bound moves, no gap closes, no obstacle is newly reached; each volume gains the
+/// mass that falls within it. Returns false, changing nothing, in any other case.
+bool addWithinExistingVolumes(const CellVolumes& added, const detail::ColumnRef& existing,
+                              const FreeSpaceRules& free_space_rules, ListMerger& merger) {
+  Volume* positive = const_cast<Volume*>(existing.positive);
+  Volume* negative = const_cast<Volume*>(existing.negative);
+  // Visits the positive volume that holds each hit; false if one has none, or holds two hits
+  // (three masses summed: their order would matter).
+  auto for_each_holder = [&](auto&& visit) {
+    std::uint32_t k = 0;
+    bool holds_one = false;
+    for (const Volume& hit : added.positive) {
+      for (; k < existing.num_positive && positive[k].top < hit.top; ++k) holds_one = false;
+      if (k == existing.num_positive || positive[k].bottom > hit.bottom || holds_one) return false;
+      holds_one = true;
+      visit(positive[k], hit);
+    }
+    return true;
+  };
+  if (!for_each_holder([](Volume&, const Volume&) {}) ||
+      !merger.keepsUnchanged(VolumeRun(negative, existing.num_negative),
+                             VolumeRun(positive, existing.num_positive), free_space_rules)) {
+    return false;
+  }
+  if (!added.negative.empty() &&
+      !addCoveredFreeSpace(added.negative, negative, existing.num_negative)) {
+    return false;
+  }
+  for_each_holder([](Volume& holder, const Volume& hit) {
+    holder.mass = static_cast<float>(static_cast<double>(holder.mass) + hit.mass);
+  });
+  return true;
+}
+
 /// Merges what the scan saw in cell `local` of a tile (`hits`, and its scratches' free space)
 /// into the cell's lists `existing`, in place where their lengths stay, else into the tile's
 /// rewrite. Out of line: the loop over a tile's cells then keeps the commonest case's values in
@@ -244,9 +281,12 @@ inline bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t
   Volume* stored = const_cast<Volume*>(existing.positive);
   scanColumn(local, hits, detail::joinGapOf(rules), work);
   addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
-  if (work.added.positive.empty() &&
-      addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
-                          existing.num_negative)) {
+  const FreeSpaceRules free_space_rules{rules.split_free_space_at_obstacles,
+                                        rules.clip_free_space_at_hits};
+  if (work.added.positive.empty()
+          ? addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
+                                existing.num_negative)
+          : addWithinExistingVolumes(work.added, existing, free_space_rules, work.merger)) {
     return;
   }
   work.existing_positive.assign(existing.positive, existing.positive + existing.num_positive);
@@ -258,8 +298,7 @@ inline bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t
                       work.merged.positive);
   }
   work.merger.merge(work.existing_negative, work.added.negative, work.merged.positive,
-                    {rules.split_free_space_at_obstacles, rules.clip_free_space_at_hits}, unit_mass,
-                    work.merged.negative);
+                    free_space_rules, unit_mass, work.merged.negative);
   const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
   const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());
   if (!existing.empty() && num_positive == existing.num_positive &&

@@ -474,6 +474,68 @@ TEST(ListMerger, SplitMergesConserveMass) {
   }
 }
 
+TEST(ListMerger, KeepsUnchangedExactlyWhatAMergeWithNothingAddedKeeps) {
+  // keepsUnchanged lets the scan update add masses in place. It must hold for every list a merge
+  // returns, and exactly where merging the list again with nothing added returns it bit for bit:
+  // also under obstacles that a forgetting dropped, a cleared box shortened or a hit grew since.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> bottom(-20.0f, 20.0f);
+  std::uniform_real_distribution<float> height(0.0f, 4.0f);
+  auto same = [](const std::vector<Volume>& a, const std::vector<Volume>& b) {
+    return a.size() == b.size() &&
+           std::equal(a.begin(), a.end(), b.begin(), [](const Volume& x, const Volume& y) {
+             return std::memcmp(&x, &y, sizeof(Volume)) == 0;
+           });
+  };
+  int kept = 0;
+  int changed = 0;
+  for (const FreeSpaceRules rules :
+       {FreeSpaceRules{false, false}, FreeSpaceRules{true, false}, FreeSpaceRules{true, true}}) {
+    for (int trial = 0; trial < 300; ++trial) {
+      ListMerger merger;
+      std::vector<Volume> positive;
+      std::vector<Volume> negative;
+      for (int step = 0; step < 4; ++step) {
+        std::vector<Volume> hits;
+        std::vector<Volume> free;
+        for (int k = 0; k < 2; ++k) {
+          const float b = bottom(rng);
+          hits.push_back(makeVolume(b, b + 0.5f * height(rng)));
+        }
+        for (int k = 0; k < 4; ++k) {
+          const float b = bottom(rng);
+          free.push_back(makeVolume(b, b + height(rng)));
+        }
+        positive = merged(positive, hits);
+        std::vector<Volume> out;
+        merger.merge(negative, free, positive, rules, 1.0f, out);
+        negative.swap(out);
+        ASSERT_TRUE(merger.keepsUnchanged(negative, positive, rules)) << "trial " << trial;
+      }
+      std::vector<std::vector<Volume>> obstacle_sets{positive};
+      if (!positive.empty()) {
+        obstacle_sets.emplace_back(positive.begin() + 1, positive.end());
+        std::vector<Volume> shortened = positive;
+        Volume& last = shortened.back();
+        last.top = std::max(last.bottom + kMinVolumeHeight, last.top - 0.5f * height(rng));
+        obstacle_sets.push_back(shortened);
+        std::vector<Volume> grown = positive;
+        grown.back().top += height(rng);
+        obstacle_sets.push_back(grown);
+      }
+      for (const std::vector<Volume>& obstacles : obstacle_sets) {
+        std::vector<Volume> again;
+        merger.merge(negative, {}, obstacles, rules, 1.0f, again);
+        const bool keeps = merger.keepsUnchanged(negative, obstacles, rules);
+        ASSERT_EQ(keeps, same(again, negative)) << "trial " << trial;
+        ++(keeps ? kept : changed);
+      }
+    }
+  }
+  EXPECT_GT(kept, 1000);
+  EXPECT_GT(changed, 100);
+}
+
 // ---- findVolume ---------------------------------------------------------------------------------
 
 TEST(FindVolume, FindsTheVolumeContainingAHeight) {
