@@ -320,6 +320,24 @@ TEST(Insertion, WithoutNegativeSpaceOnlyObstaclesAreStored) {
   EXPECT_EQ(map.bounds().max, (CellIndex{0, 5}));
 }
 
+TEST(Insertion, HitsInsideOneObstacleAddTheirMassesInOneSum) {
+  // Eq. (7) merges a scan's volumes with the list at once: the masses 2^24 + 1 + 1 sum to
+  // 2^24 + 2, a float. Added one after the other, each sum rounded to float, they would leave 2^24.
+  Map map(unitConfig());
+  map.setCellVolumes({0, 0}, CellVolumes{{Volume{0.0f, 10.0f, 16777216.0f}}, {}});
+  Scan scan;
+  scan.origin = {0.5, 0.5, 20.0};
+  scan.hits = {{0.5f, 0.5f, 2.0f}, {0.5f, 0.5f, 7.0f}};  // [1.5, 2.5] and [6.5, 7.5], mass 1 each
+  InsertionConfig config;
+  config.model_negative_space = false;
+  map.insertScan(scan, config);
+  const CellVolumes held = map.cellVolumes({0, 0});
+  ASSERT_EQ(held.positive.size(), 1u);
+  EXPECT_EQ(held.positive[0].bottom, 0.0f);
+  EXPECT_EQ(held.positive[0].top, 10.0f);
+  EXPECT_EQ(held.positive[0].mass, 16777218.0f);
+}
+
 TEST(Insertion, BoundsHoldOnlyCellsWithVolumes) {
   // A ray starting on the wall it leaves through never crosses its start cell: the start cell
   // gets no volume, and bounds() must not include it.
