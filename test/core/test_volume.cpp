@@ -477,7 +477,7 @@ TEST(ListMerger, SplitMergesConserveMass) {
 TEST(ListMerger, KeepsUnchangedExactlyWhatAMergeWithNothingAddedKeeps) {
   // keepsUnchanged lets the scan update add masses in place. It must hold for every list a merge
   // returns, and exactly where merging the list again with nothing added returns it bit for bit:
-  // also under obstacles that a forgetting dropped, a cleared box shortened or a hit grew since.
+  // also under obstacles dropped, shortened or grown since (as under a list given whole).
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> bottom(-20.0f, 20.0f);
   std::uniform_real_distribution<float> height(0.0f, 4.0f);
