@@ -246,7 +246,9 @@ class Map {
   /// Sec. III-A constraints (checkColumn under the map's rules; finite non-negative masses
   /// representable in the map's decayed mass unit), every cell lies within max_coordinate (|i|,
   /// |j| <= max_coordinate / resolution + 1, the cells readings can reach) and appears once.
-  /// Emptying a cell removes it from bounds().
+  /// Emptying a cell removes it from bounds(). Under ModelRules::split_free_space_at_obstacles,
+  /// a negative list is stored as ListMerger cuts it (a volume reaching into an obstacle cut at
+  /// its bottom and top, each piece with the mass within its heights), as insertion leaves it.
   void setCellVolumes(const std::vector<CellAssignment>& cells);
   void setCellVolumes(const CellIndex& cell, const CellVolumes& volumes);
 

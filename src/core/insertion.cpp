@@ -281,8 +281,7 @@ bool addWithinExistingVolumes(const CellVolumes& added, const detail::ColumnRef&
   Volume* stored = const_cast<Volume*>(existing.positive);
   scanColumn(local, hits, detail::joinGapOf(rules), work);
   addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
-  const FreeSpaceRules free_space_rules{rules.split_free_space_at_obstacles,
-                                        rules.clip_free_space_at_hits};
+  const FreeSpaceRules free_space_rules = detail::freeSpaceRulesOf(rules);
   if (work.added.positive.empty()
           ? addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
                                 existing.num_negative)

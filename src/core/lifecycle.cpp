@@ -203,8 +203,7 @@ ForgetResult Map::forget(double min_mass) {
   if (candidates.empty()) return result;
 
   ++revision_;
-  const FreeSpaceRules free_space_rules{config_.rules.split_free_space_at_obstacles,
-                                        config_.rules.clip_free_space_at_hits};
+  const FreeSpaceRules free_space_rules = detail::freeSpaceRulesOf(config_.rules);
   ColumnEdit work;
   for (const auto it : candidates) {
     detail::TileBlock& tile = it->second;

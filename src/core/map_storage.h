@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "mvog/constraints.h"
 #include "mvog/map.h"
 #include "tile_block.h"
 
@@ -44,6 +45,11 @@ class TileRemovalLog {
 
 /// A number that tells maps apart (incremental updates name their source map with it).
 std::uint64_t newMapId();
+
+/// How ListMerger treats a negative list under the map's rules.
+inline FreeSpaceRules freeSpaceRulesOf(const ModelRules& rules) {
+  return {rules.split_free_space_at_obstacles, rules.clip_free_space_at_hits};
+}
 
 }  // namespace detail
 

@@ -98,8 +98,7 @@ void Map::merge(const Map& other, const GridTransform& this_from_other) {
   }
   const auto dz = static_cast<float>(this_from_other.dz * scale_inverse_);
   const double max_cell = config_.max_coordinate * scale_inverse_ + 1.0;  // as setCellVolumes
-  const FreeSpaceRules free_space_rules{config_.rules.split_free_space_at_obstacles,
-                                        config_.rules.clip_free_space_at_hits};
+  const FreeSpaceRules free_space_rules = detail::freeSpaceRulesOf(config_.rules);
   ListMerger merger;
   CellVolumes added;
   std::vector<CellAssignment> merged;

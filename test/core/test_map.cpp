@@ -339,6 +339,33 @@ TEST(Map, SetCellVolumesOnADecayedMapKeepsTheGivenMasses) {
   EXPECT_FLOAT_EQ(map.cellVolumes({1, 2}).positive.at(0).mass, 4.0f);
 }
 
+TEST(Map, SetCellVolumesStoresFreeSpaceAcrossAnObstacleAsTheMergeCutsIt) {
+  // Sec. III-A allows one negative volume across a positive one; under
+  // split_free_space_at_obstacles it is stored cut at the obstacle's bottom and top, each piece
+  // with the mass within its heights (density 0.5 here), as an insertion's merge leaves it.
+  const ModelRules rules;  // the defaults split free space at obstacles
+  ASSERT_TRUE(rules.split_free_space_at_obstacles);
+  Map given_whole(unitConfig(10000.0, rules));
+  Map given_cut(unitConfig(10000.0, rules));
+  given_whole.setCellVolumes({0, 0}, CellVolumes{{{2, 4, 1}}, {{0, 10, 5}}});
+  given_cut.setCellVolumes({0, 0}, CellVolumes{{{2, 4, 1}}, {{0, 2, 1}, {2, 4, 1}, {4, 10, 3}}});
+  EXPECT_EQ(allVolumes(given_whole), (std::vector<test::VolumeRecord>{{0, 0, 0, 2.f, 4.f, 1.f},
+                                                                      {0, 0, 1, 0.f, 2.f, 1.f},
+                                                                      {0, 0, 1, 2.f, 4.f, 1.f},
+                                                                      {0, 0, 1, 4.f, 10.f, 3.f}}));
+  // Then a ray whose free space alone crosses the column, and one that hits it: both maps go on
+  // alike (a scan's free space within a column's free space is added in place).
+  for (Map* map : {&given_whole, &given_cut}) {
+    map->insertReading({-2.5, 0.5, 6.5}, {3.5, 0.5, 6.5}, ReadingKind::kObstacle);
+    map->insertReading({-2.5, 0.5, 3.0}, {0.5, 0.5, 3.0}, ReadingKind::kObstacle);
+  }
+  EXPECT_TRUE(test::sameVolumes(allVolumes(given_whole), allVolumes(given_cut)));
+  // The paper's model does not split: the list is kept whole.
+  Map paper(unitConfig());
+  paper.setCellVolumes({0, 0}, CellVolumes{{{2, 4, 1}}, {{0, 10, 5}}});
+  EXPECT_EQ(paper.cellVolumes({0, 0}).negative.size(), 1u);
+}
+
 TEST(Map, SetCellVolumesReplacesAndEmptiesCells) {
   Map map(unitConfig());
   map.setCellVolumes({-3, 4}, CellVolumes{{{0, 1, 2}}, {{-5, -2, 3}, {0, 4, 1}}});
