@@ -234,6 +234,52 @@ inline bool addCoveredFreeSpace(VolumeRun added, Volume* negative, std::uint32_t
   return addSpanningFreeSpace(added, negative, num_negative);
 }
 
+/// Free space that reaches beyond one run of touching negative volumes (the pieces of one free
+/// volume, split at obstacles) at one end or both, by overlap or across a gap of at most
+/// kMaxMergeGap, and no other run: the run's end piece grows to take it in. What ListMerger
+/// gives (on a list it keeps, as every stored one is) when no obstacle lies within the grown
+/// piece: no cut moves, no piece appears; the grown piece sums its own and the added mass (both
+/// wholly within it), then the gap's of eq. (8), as the merge sums them. Returns false, changing
+/// nothing, in any other case.
+bool extendFreeRun(const Volume& added, Volume* negative, std::uint32_t num_negative,
+                   VolumeRun obstacles, float unit_mass) {
+  // The first volume within kMaxMergeGap of the added one, and the run it belongs to. Those
+  // before it end more than kMaxMergeGap below the added one.
+  std::uint32_t first = 0;
+  while (first < num_negative && !mustMerge(negative[first].top, added.bottom)) ++first;
+  if (first == num_negative || !mustMerge(added.top, negative[first].bottom)) return false;
+  std::uint32_t run_begin = first;
+  while (run_begin > 0 && negative[run_begin - 1].top == negative[run_begin].bottom) --run_begin;
+  std::uint32_t run_end = first + 1;
+  while (run_end < num_negative && negative[run_end].bottom == negative[run_end - 1].top) {
+    ++run_end;
+  }
+  const float run_bottom = negative[run_begin].bottom;
+  const float run_top = negative[run_end - 1].top;
+  const bool below = added.bottom < run_bottom;
+  const bool above = added.top > run_top;
+  if (!below && !above) return false;  // within the run: addCoveredFreeSpace's case
+  Volume& piece = below ? negative[run_begin] : negative[run_end - 1];
+  const float bottom = std::min(piece.bottom, added.bottom);
+  const float top = std::max(piece.top, added.top);
+  // Pieces of a run meet only at an obstacle's bottom or top, and each obstacle the run reaches
+  // lies within it: heights that overlap no obstacle lie within one piece of the grown run.
+  for (const Volume& obstacle : obstacles) {
+    if (obstacle.bottom >= top) break;
+    if (bottom < obstacle.top) return false;
+  }
+  // Growing upwards, it must not come within kMaxMergeGap of the next run (the one before lies
+  // further below the added volume).
+  if (run_end < num_negative && mustMerge(top, negative[run_end].bottom)) return false;
+  double gap = 0.0;
+  if (below && added.top < run_bottom) gap = static_cast<double>(run_bottom) - added.top;
+  if (above && added.bottom > run_top) gap = static_cast<double>(added.bottom) - run_top;
+  double mass = static_cast<double>(piece.mass) + added.mass;
+  if (gap > 0.0) mass += gap * unit_mass;
+  piece = {bottom, top, static_cast<float>(mass)};
+  return true;
+}
+
 /// The commonest update of a column with hits once its surface has been seen: each hit within a
 /// positive volume of its own, the free space (if any) within the negative list's runs, and a
 /// negative list that the merge keeps as it is (ListMerger::keepsUnchanged). What ListMerger
@@ -284,7 +330,11 @@ bool addWithinExistingVolumes(const CellVolumes& added, const detail::ColumnRef&
   const FreeSpaceRules free_space_rules = detail::freeSpaceRulesOf(rules);
   if (work.added.positive.empty()
           ? addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
-                                existing.num_negative)
+                                existing.num_negative) ||
+                (work.added.negative.size() == 1 &&
+                 extendFreeRun(work.added.negative[0], stored + existing.num_positive,
+                               existing.num_negative,
+                               VolumeRun(existing.positive, existing.num_positive), unit_mass))
           : addWithinExistingVolumes(work.added, existing, free_space_rules, work.merger)) {
     return;
   }

@@ -400,6 +400,12 @@ TEST(Insertion, ResultCountsEveryReadingOnce) {
 
 // ---- The scan update (Fig. 2) ------------------------------------------------------------------
 
+/// Whether two lists hold the same volumes, bit for bit.
+bool sameBits(const std::vector<Volume>& a, const std::vector<Volume>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Volume)) == 0);
+}
+
 TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
   // Vertical readings reach one cell each, so with the paper's model what each cell must hold
   // follows from makeVolume and the list rules alone (Sec. III-B.2: an obstacle's positive
@@ -407,76 +413,143 @@ TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
   // out-of-range reading). Many readings into 2 x 2 cells make both lists of each cell grow,
   // merge, shrink and grow again, which the map does in tiles written in place or rebuilt, with
   // masses rescaled after decay: it must hold exactly the lists the rules give, bit for bit.
-  Map map(unitConfig());
-  std::vector<std::vector<Volume>> positive(4);
-  std::vector<std::vector<Volume>> negative(4);
-  ListMerger merger;
-  auto insert_into = [&](std::vector<Volume>& list, const Volume& volume) {
-    std::vector<Volume> out;
-    merger.merge(list, VolumeRun(&volume, 1), {}, {}, 1.0f, out);
-    list = out;
-  };
-  // Short rays at one of 8 levels 12 apart: volumes of one level merge, different levels stay
-  // apart, so the lists hold up to 8 volumes and a volume bridging two of a level shrinks them.
-  std::mt19937 rng(5);
-  std::uniform_int_distribution<int> level_of(0, 7);
-  std::uniform_int_distribution<int> quarters(0, 8);
-  std::uniform_int_distribution<int> length_in_eighths(1, 20);
-  std::uniform_int_distribution<int> cell_of(0, 3);
-  std::bernoulli_distribution is_obstacle(0.4);
-  std::bernoulli_distribution upwards(0.5);
-  for (int step = 0; step < 4000; ++step) {
-    const int c = cell_of(rng);
-    const double x = (c % 2) + 0.5;
-    const double y = (c / 2) + 0.5;
-    // The first readings stay on one level, so that columns hold one free-space volume for a
-    // while (the commonest case, which the map updates in place).
-    const int level = step < 400 ? 0 : level_of(rng);
-    const double z0 = 12.0 * level + quarters(rng) / 4.0;
-    const double length = length_in_eighths(rng) / 8.0;
-    const double z1 = upwards(rng) ? z0 + length : z0 - length;
-    const bool obstacle = is_obstacle(rng);
-    map.insertReading({x, y, z0}, {x, y, z1},
-                      obstacle ? ReadingKind::kObstacle : ReadingKind::kOutOfRange);
-    const auto start_z = static_cast<float>(z0);
-    const auto end_z = static_cast<float>(z1);
-    if (obstacle) {
-      const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
-      insert_into(positive[c], hit);
-      if (std::fabs(z0 - z1) > 1.0) {
-        insert_into(negative[c], makeVolume(start_z, z0 < z1 ? hit.bottom : hit.top));
+  // With split_free_space_at_obstacles too (Sec. V.C): the negative list is then cut at the
+  // obstacles of the column's positive list as each reading leaves it.
+  ModelRules split = ModelRules::paper();
+  split.split_free_space_at_obstacles = true;
+  for (const ModelRules& rules : {ModelRules::paper(), split}) {
+    SCOPED_TRACE(rules.split_free_space_at_obstacles ? "split" : "paper");
+    Map map(unitConfig(10000.0, rules));
+    std::vector<std::vector<Volume>> positive(4);
+    std::vector<std::vector<Volume>> negative(4);
+    ListMerger merger;
+    const FreeSpaceRules free_space_rules{rules.split_free_space_at_obstacles, false};
+    // Merges `added` (none, one volume) into a cell's lists as a reading does.
+    auto insert_into = [&](int c, std::vector<Volume>& list, VolumeRun added) {
+      std::vector<Volume> out;
+      if (&list == &positive[c]) {
+        merger.merge(list, added, {}, {}, 1.0f, out);
+      } else {
+        merger.merge(list, added, positive[c], free_space_rules, 1.0f, out);
       }
-    } else {
-      insert_into(negative[c], makeVolume(start_z, end_z));
-    }
-    const CellVolumes held = map.cellVolumes({c % 2, c / 2});
-    auto same = [](const std::vector<Volume>& a, const std::vector<Volume>& b) {
-      return a.size() == b.size() &&
-             (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Volume)) == 0);
+      list = out;
     };
-    ASSERT_TRUE(same(held.positive, positive[c]))
-        << "positive list of cell " << c << ", step " << step;
-    ASSERT_TRUE(same(held.negative, negative[c]))
-        << "negative list of cell " << c << ", step " << step;
-    if (step % 500 == 499) {
-      // Decay by 1/2: exact in float, so the rules' masses halve exactly too (Sec. III-E), and
-      // the map rescales a tile's masses when it next writes to it.
-      map.decay(0.5);
-      for (auto* lists : {&positive, &negative}) {
-        for (std::vector<Volume>& list : *lists) {
-          for (Volume& v : list) v.mass *= 0.5f;
+    // Short rays at one of 8 levels 12 apart: volumes of one level merge, different levels stay
+    // apart, so the lists hold up to 8 volumes and a volume bridging two of a level shrinks them.
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<int> level_of(0, 7);
+    std::uniform_int_distribution<int> quarters(0, 8);
+    std::uniform_int_distribution<int> length_in_eighths(1, 20);
+    std::uniform_int_distribution<int> cell_of(0, 3);
+    std::bernoulli_distribution is_obstacle(0.4);
+    std::bernoulli_distribution upwards(0.5);
+    for (int step = 0; step < 4000; ++step) {
+      const int c = cell_of(rng);
+      const double x = (c % 2) + 0.5;
+      const double y = (c / 2) + 0.5;
+      // The first readings stay on one level, so that columns hold one free-space volume for a
+      // while (the commonest case, which the map updates in place).
+      const int level = step < 400 ? 0 : level_of(rng);
+      const double z0 = 12.0 * level + quarters(rng) / 4.0;
+      const double length = length_in_eighths(rng) / 8.0;
+      const double z1 = upwards(rng) ? z0 + length : z0 - length;
+      const bool obstacle = is_obstacle(rng);
+      map.insertReading({x, y, z0}, {x, y, z1},
+                        obstacle ? ReadingKind::kObstacle : ReadingKind::kOutOfRange);
+      const auto start_z = static_cast<float>(z0);
+      const auto end_z = static_cast<float>(z1);
+      if (obstacle) {
+        const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
+        insert_into(c, positive[c], VolumeRun(&hit, 1));
+        const Volume free = makeVolume(start_z, z0 < z1 ? hit.bottom : hit.top);
+        insert_into(c, negative[c], VolumeRun(&free, std::fabs(z0 - z1) > 1.0 ? 1 : 0));
+      } else {
+        const Volume free = makeVolume(start_z, end_z);
+        insert_into(c, negative[c], VolumeRun(&free, 1));
+      }
+      const CellVolumes held = map.cellVolumes({c % 2, c / 2});
+      ASSERT_TRUE(sameBits(held.positive, positive[c]))
+          << "positive list of cell " << c << ", step " << step;
+      ASSERT_TRUE(sameBits(held.negative, negative[c]))
+          << "negative list of cell " << c << ", step " << step;
+      if (step % 500 == 499) {
+        // Decay by 1/2: exact in float, so the rules' masses halve exactly too (Sec. III-E), and
+        // the map rescales a tile's masses when it next writes to it.
+        map.decay(0.5);
+        for (auto* lists : {&positive, &negative}) {
+          for (std::vector<Volume>& list : *lists) {
+            for (Volume& v : list) v.mass *= 0.5f;
+          }
         }
       }
     }
+    std::size_t most_positive = 0;
+    std::size_t most_negative = 0;
+    for (int c = 0; c < 4; ++c) {
+      most_positive = std::max(most_positive, positive[c].size());
+      most_negative = std::max(most_negative, negative[c].size());
+    }
+    EXPECT_GE(most_positive, 3u);  // the lists did hold several volumes
+    EXPECT_GE(most_negative, 2u);
   }
-  std::size_t most_positive = 0;
-  std::size_t most_negative = 0;
-  for (int c = 0; c < 4; ++c) {
-    most_positive = std::max(most_positive, positive[c].size());
-    most_negative = std::max(most_negative, negative[c].size());
+}
+
+TEST(Insertion, FreeSpaceReachingBeyondAColumnsFreeVolumesIsMergedAsTheRulesSay) {
+  // A vertical ray without a return, through one cell, beside free volumes already there (split
+  // at an obstacle, Sec. V.C): the cell must hold what ListMerger gives, bit for bit, whether the
+  // new volume grows the run it reaches (overlapping it, across a gap of eq. 8, past both of its
+  // ends), bridges two runs, or reaches past a piece into the next.
+  ModelRules rules = ModelRules::paper();
+  rules.split_free_space_at_obstacles = true;
+  struct Case {
+    const char* name;
+    CellVolumes given;
+    float z0;
+    float z1;
+  };
+  const std::vector<Case> cases{
+      {"grows a volume upwards", {{}, {{0, 2, 3}}}, 1.5f, 4.0f},
+      {"across a gap below", {{}, {{2, 4, 3}}}, 0.25f, 1.5f},
+      {"across a gap above", {{}, {{2, 4, 3}}}, 4.5f, 6.0f},
+      {"past both ends of a volume", {{}, {{2, 4, 3}}}, 1.0f, 5.0f},
+      {"bridges two runs", {{}, {{0, 2, 2}, {3.5f, 5, 1.5f}}}, 2.25f, 3.25f},
+      {"across a gap up to the next run", {{}, {{0, 2, 2}, {4, 5, 1}}}, 2.5f, 3.5f},
+      {"grows the piece below an obstacle",
+       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
+       0.0f,
+       2.5f},
+      {"grows the piece above an obstacle",
+       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
+       5.0f,
+       7.5f},
+      {"past both ends of a run of pieces",
+       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
+       -1.0f,
+       8.0f},
+      {"into the next piece from below",
+       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
+       -0.5f,
+       3.5f},
+      {"into the next piece from above",
+       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
+       3.5f,
+       7.0f},
+      {"grows an obstacle's piece", {{{0, 1, 1}}, {{0, 1, 1}, {1, 3, 2}}}, -2.0f, 0.5f},
+      {"over an obstacle beyond the run", {{{5, 6, 1}}, {{1, 3, 2}}}, 2.0f, 5.5f}};
+  ListMerger merger;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    Map map(unitConfig(10000.0, rules));
+    map.setCellVolumes({0, 0}, c.given);
+    map.insertReading({0.5, 0.5, c.z0}, {0.5, 0.5, c.z1}, ReadingKind::kOutOfRange);
+    const Volume free = makeVolume(c.z0, c.z1);
+    std::vector<Volume> expected;
+    merger.merge(c.given.negative, VolumeRun(&free, 1), c.given.positive,
+                 FreeSpaceRules{true, false}, 1.0f, expected);
+    const CellVolumes held = map.cellVolumes({0, 0});
+    EXPECT_TRUE(sameBits(held.positive, c.given.positive));
+    EXPECT_TRUE(sameBits(held.negative, expected));
   }
-  EXPECT_GE(most_positive, 3u);  // the lists did hold several volumes
-  EXPECT_GE(most_negative, 2u);
 }
 
 /// The model's rules the properties below hold for: the paper's, the defaults, and each
