@@ -317,6 +317,36 @@ bool addWithinExistingVolumes(const CellVolumes& added, const detail::ColumnRef&
   return true;
 }
 
+/// The merge of a column's lists with new volumes that touch none of them (nor come within
+/// kMaxMergeGap), where the merged free list is one the merge keeps (ListMerger::keepsUnchanged:
+/// no free volume newly reaches an obstacle, or a hit one): both lists interleaved, each volume
+/// its own source with its own mass, which is what ListMerger gives then. A new column's lists,
+/// or a free volume or a hit at new heights, mostly. Returns false in any other case.
+bool mergeWithoutContact(const detail::ColumnRef& existing, const CellVolumes& added,
+                         const FreeSpaceRules& free_space_rules, ListMerger& merger,
+                         CellVolumes& merged) {
+  // Interleaves a list with its new volumes by bottom; consecutive volumes must be more than
+  // kMaxMergeGap apart (or touch, where `may_touch`: pieces of a free volume cut at obstacles).
+  auto interleave = [](const Volume* list, std::uint32_t count, const std::vector<Volume>& new_ones,
+                       bool may_touch, std::vector<Volume>& out) {
+    out.resize(count + new_ones.size());
+    std::merge(list, list + count, new_ones.begin(), new_ones.end(), out.begin(),
+               [](const Volume& a, const Volume& b) { return a.bottom < b.bottom; });
+    for (std::size_t k = 1; k < out.size(); ++k) {
+      if (mustMerge(out[k - 1].top, out[k].bottom) &&
+          !(may_touch && out[k].bottom == out[k - 1].top)) {
+        return false;
+      }
+    }
+    return true;
+  };
+  return interleave(existing.positive, existing.num_positive, added.positive, false,
+                    merged.positive) &&
+         interleave(existing.negative, existing.num_negative, added.negative, true,
+                    merged.negative) &&
+         merger.keepsUnchanged(merged.negative, merged.positive, free_space_rules);
+}
+
 /// Merges what the scan saw in cell `local` of a tile (`hits`, and its scratches' free space)
 /// into the cell's lists `existing`, in place where their lengths stay, else into the tile's
 /// rewrite. Out of line: the loop over a tile's cells then keeps the commonest case's values in
@@ -338,16 +368,18 @@ bool addWithinExistingVolumes(const CellVolumes& added, const detail::ColumnRef&
           : addWithinExistingVolumes(work.added, existing, free_space_rules, work.merger)) {
     return;
   }
-  work.existing_positive.assign(existing.positive, existing.positive + existing.num_positive);
-  work.existing_negative.assign(existing.negative, existing.negative + existing.num_negative);
-  if (work.added.positive.empty()) {
-    work.merged.positive = work.existing_positive;
-  } else {
-    work.merger.merge(work.existing_positive, work.added.positive, {}, {}, unit_mass,
-                      work.merged.positive);
+  if (!mergeWithoutContact(existing, work.added, free_space_rules, work.merger, work.merged)) {
+    work.existing_positive.assign(existing.positive, existing.positive + existing.num_positive);
+    work.existing_negative.assign(existing.negative, existing.negative + existing.num_negative);
+    if (work.added.positive.empty()) {
+      work.merged.positive = work.existing_positive;
+    } else {
+      work.merger.merge(work.existing_positive, work.added.positive, {}, {}, unit_mass,
+                        work.merged.positive);
+    }
+    work.merger.merge(work.existing_negative, work.added.negative, work.merged.positive,
+                      free_space_rules, unit_mass, work.merged.negative);
   }
-  work.merger.merge(work.existing_negative, work.added.negative, work.merged.positive,
-                    free_space_rules, unit_mass, work.merged.negative);
   const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
   const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());
   if (!existing.empty() && num_positive == existing.num_positive &&

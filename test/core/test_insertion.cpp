@@ -494,11 +494,12 @@ TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
   }
 }
 
-TEST(Insertion, FreeSpaceReachingBeyondAColumnsFreeVolumesIsMergedAsTheRulesSay) {
-  // A vertical ray without a return, through one cell, beside free volumes already there (split
-  // at an obstacle, Sec. V.C): the cell must hold what ListMerger gives, bit for bit, whether the
-  // new volume grows the run it reaches (overlapping it, across a gap of eq. 8, past both of its
-  // ends), bridges two runs, or reaches past a piece into the next.
+TEST(Insertion, NewVolumesBesideAColumnsVolumesAreMergedAsTheRulesSay) {
+  // A vertical ray through one cell, beside volumes already there (free ones split at an
+  // obstacle, Sec. V.C): the cell must hold what ListMerger gives, bit for bit, whether its free
+  // volume grows the run it reaches (overlapping it, across a gap of eq. 8, past both of its
+  // ends), bridges two runs, reaches past a piece into the next or across an obstacle, or its
+  // volumes lie apart from all (near, but more than kMaxMergeGap away).
   ModelRules rules = ModelRules::paper();
   rules.split_free_space_at_obstacles = true;
   struct Case {
@@ -506,49 +507,57 @@ TEST(Insertion, FreeSpaceReachingBeyondAColumnsFreeVolumesIsMergedAsTheRulesSay)
     CellVolumes given;
     float z0;
     float z1;
+    ReadingKind kind;
   };
+  constexpr ReadingKind kFree = ReadingKind::kOutOfRange;
+  constexpr ReadingKind kHit = ReadingKind::kObstacle;
+  const CellVolumes pieces{{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}};
   const std::vector<Case> cases{
-      {"grows a volume upwards", {{}, {{0, 2, 3}}}, 1.5f, 4.0f},
-      {"across a gap below", {{}, {{2, 4, 3}}}, 0.25f, 1.5f},
-      {"across a gap above", {{}, {{2, 4, 3}}}, 4.5f, 6.0f},
-      {"past both ends of a volume", {{}, {{2, 4, 3}}}, 1.0f, 5.0f},
-      {"bridges two runs", {{}, {{0, 2, 2}, {3.5f, 5, 1.5f}}}, 2.25f, 3.25f},
-      {"across a gap up to the next run", {{}, {{0, 2, 2}, {4, 5, 1}}}, 2.5f, 3.5f},
-      {"grows the piece below an obstacle",
-       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
-       0.0f,
-       2.5f},
-      {"grows the piece above an obstacle",
-       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
-       5.0f,
-       7.5f},
-      {"past both ends of a run of pieces",
-       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
-       -1.0f,
-       8.0f},
-      {"into the next piece from below",
-       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
-       -0.5f,
-       3.5f},
-      {"into the next piece from above",
-       {{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}},
-       3.5f,
-       7.0f},
-      {"grows an obstacle's piece", {{{0, 1, 1}}, {{0, 1, 1}, {1, 3, 2}}}, -2.0f, 0.5f},
-      {"over an obstacle beyond the run", {{{5, 6, 1}}, {{1, 3, 2}}}, 2.0f, 5.5f}};
+      {"grows a volume upwards", {{}, {{0, 2, 3}}}, 1.5f, 4.0f, kFree},
+      {"across a gap below", {{}, {{2, 4, 3}}}, 0.25f, 1.5f, kFree},
+      {"across a gap above", {{}, {{2, 4, 3}}}, 4.5f, 6.0f, kFree},
+      {"past both ends of a volume", {{}, {{2, 4, 3}}}, 1.0f, 5.0f, kFree},
+      {"bridges two runs", {{}, {{0, 2, 2}, {3.5f, 5, 1.5f}}}, 2.25f, 3.25f, kFree},
+      {"across a gap up to the next run", {{}, {{0, 2, 2}, {4, 5, 1}}}, 2.5f, 3.5f, kFree},
+      {"grows the piece below an obstacle", pieces, 0.0f, 2.5f, kFree},
+      {"grows the piece above an obstacle", pieces, 5.0f, 7.5f, kFree},
+      {"past both ends of a run of pieces", pieces, -1.0f, 8.0f, kFree},
+      {"into the next piece from below", pieces, -0.5f, 3.5f, kFree},
+      {"into the next piece from above", pieces, 3.5f, 7.0f, kFree},
+      {"grows an obstacle's piece", {{{0, 1, 1}}, {{0, 1, 1}, {1, 3, 2}}}, -2.0f, 0.5f, kFree},
+      {"over an obstacle beyond the run", {{{5, 6, 1}}, {{1, 3, 2}}}, 2.0f, 5.5f, kFree},
+      {"across an obstacle", {{{2, 3, 1}}, {}}, 0.0f, 5.0f, kFree},
+      {"from an obstacle's top", {{{0, 1, 1}}, {}}, 1.0f, 4.0f, kFree},
+      {"a little more than a gap above", {{{0, 1, 1}}, {{1, 3, 2}}}, 4.25f, 6.0f, kFree},
+      {"a hit near an obstacle", {{{2, 3, 1}}, {}}, 8.0f, 4.25f, kHit},
+      {"a hit on an obstacle's top", {{{2, 3, 1}}, {}}, 8.0f, 3.5f, kHit},
+      {"a hit a little more than a gap away", {{{2, 3, 1}}, {}}, 8.0f, 4.75f, kHit},
+      {"a hit near free space", {{{0, 1, 1}}, {{1, 3, 2}}}, 3.5f, 6.0f, kHit},
+      {"a hit above everything", {{{0, 1, 1}}, {{1, 3, 2}}}, 8.0f, 8.6f, kHit}};
   ListMerger merger;
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     Map map(unitConfig(10000.0, rules));
     map.setCellVolumes({0, 0}, c.given);
-    map.insertReading({0.5, 0.5, c.z0}, {0.5, 0.5, c.z1}, ReadingKind::kOutOfRange);
-    const Volume free = makeVolume(c.z0, c.z1);
-    std::vector<Volume> expected;
-    merger.merge(c.given.negative, VolumeRun(&free, 1), c.given.positive,
-                 FreeSpaceRules{true, false}, 1.0f, expected);
+    map.insertReading({0.5, 0.5, c.z0}, {0.5, 0.5, c.z1}, c.kind);
+    // The reading's volumes (Sec. III-B.2): a hit's of eq. (5) and the free space up to it.
+    std::vector<Volume> hits;
+    std::vector<Volume> free;
+    if (c.kind == kHit) {
+      hits.push_back(makeVolume(c.z1 - 0.5f, c.z1 + 0.5f));
+      if (std::fabs(c.z0 - c.z1) > 1.0f) {
+        free.push_back(makeVolume(c.z0, c.z0 < c.z1 ? hits[0].bottom : hits[0].top));
+      }
+    } else {
+      free.push_back(makeVolume(c.z0, c.z1));
+    }
+    CellVolumes expected;
+    merger.merge(c.given.positive, hits, {}, {}, 1.0f, expected.positive);
+    merger.merge(c.given.negative, free, expected.positive, FreeSpaceRules{true, false}, 1.0f,
+                 expected.negative);
     const CellVolumes held = map.cellVolumes({0, 0});
-    EXPECT_TRUE(sameBits(held.positive, c.given.positive));
-    EXPECT_TRUE(sameBits(held.negative, expected));
+    EXPECT_TRUE(sameBits(held.positive, expected.positive));
+    EXPECT_TRUE(sameBits(held.negative, expected.negative));
   }
 }
 
