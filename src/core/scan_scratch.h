@@ -120,7 +120,8 @@ class ScanScratch {
       const std::int32_t ty = cell.y >> kTileSizeLog2;
       // Consecutive cells of a ray mostly share a tile.
       if (tx != x_ || ty != y_) {
-        tile_ = &scratch_.findOrAddTile(tx, ty);
+        ScratchTile* known = scratch_.denseTile(tx, ty);
+        tile_ = known != nullptr ? known : &scratch_.findOrAddTile(tx, ty);
         x_ = tx;
         y_ = ty;
       }
@@ -156,6 +157,20 @@ class ScanScratch {
   void appendFree(const ScratchTile& tile, unsigned local, std::vector<ScanInterval>& out) const;
 
  private:
+  /// Where the dense index holds tile (tile_x, tile_y), or kNotDense outside it.
+  static constexpr std::size_t kNotDense = ~std::size_t{0};
+  std::size_t denseIndex(std::int32_t tile_x, std::int32_t tile_y) const {
+    const auto column = static_cast<std::uint32_t>(tile_x - dense_min_x_);
+    const auto row = static_cast<std::uint32_t>(tile_y - dense_min_y_);
+    if (column >= dense_width_ || row >= dense_height_) return kNotDense;
+    return std::size_t{row} * dense_width_ + column;
+  }
+  /// The tile (tile_x, tile_y) if this scan reached it already and the dense index holds it,
+  /// else null. Inline: a ray's walk enters a tile every few cells.
+  ScratchTile* denseTile(std::int32_t tile_x, std::int32_t tile_y) const {
+    const std::size_t index = denseIndex(tile_x, tile_y);
+    return index == kNotDense ? nullptr : dense_[index];
+  }
   ScratchTile& findOrAddTile(std::int32_t tile_x, std::int32_t tile_y);
   /// An interval that does more than grow the inline interval of a slot of this scan.
   void addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume);
@@ -163,7 +178,11 @@ class ScanScratch {
   /// The tiles reached, by key, and the index from tile to scratch: dense over the scan's tiles
   /// when they are few enough, else hashed.
   std::vector<std::pair<std::uint64_t, ScratchTile*>> reached_;
-  CellRange dense_tiles_ = kNoCells;
+  /// The dense index: tiles [min, min + width) x [min, min + height), rows of width entries.
+  std::int32_t dense_min_x_ = 0;
+  std::int32_t dense_min_y_ = 0;
+  std::uint32_t dense_width_ = 0;
+  std::uint32_t dense_height_ = 0;
   std::vector<ScratchTile*> dense_;
   std::unordered_map<std::uint64_t, ScratchTile*> hashed_;
   std::vector<std::unique_ptr<ScratchTile>> pool_;

@@ -57,12 +57,12 @@ void ScanScratch::begin(float join_gap, bool count_masses, const CellRange& tile
   reached_.clear();
   hashed_.clear();
   others_used_ = 0;
-  if (!tiles.empty() && tiles.width() * tiles.height() <= kMaxDenseTiles) {
-    dense_tiles_ = tiles;
-    dense_.assign(static_cast<std::size_t>(tiles.width() * tiles.height()), nullptr);
-  } else {
-    dense_tiles_ = kNoCells;
-  }
+  const bool dense = !tiles.empty() && tiles.width() * tiles.height() <= kMaxDenseTiles;
+  dense_min_x_ = dense ? tiles.min.x : 0;
+  dense_min_y_ = dense ? tiles.min.y : 0;
+  dense_width_ = dense ? static_cast<std::uint32_t>(tiles.width()) : 0;
+  dense_height_ = dense ? static_cast<std::uint32_t>(tiles.height()) : 0;
+  dense_.assign(std::size_t{dense_width_} * dense_height_, nullptr);
   if (++stamp_ == 0) {  // after 2^32 scans: no slot may keep the new stamp from long ago
     for (auto& tile : pool_) {
       for (FreeSlot& slot : tile->slots) slot.stamp = 0;
@@ -72,14 +72,8 @@ void ScanScratch::begin(float join_gap, bool count_masses, const CellRange& tile
 }
 
 ScratchTile& ScanScratch::findOrAddTile(std::int32_t tile_x, std::int32_t tile_y) {
-  ScratchTile** slot = nullptr;
-  if (dense_tiles_.contains({tile_x, tile_y})) {
-    slot = &dense_[static_cast<std::size_t>(tile_y - dense_tiles_.min.y) *
-                       static_cast<std::size_t>(dense_tiles_.width()) +
-                   static_cast<std::size_t>(tile_x - dense_tiles_.min.x)];
-  } else {
-    slot = &hashed_[tileKey(tile_x, tile_y)];
-  }
+  const std::size_t index = denseIndex(tile_x, tile_y);
+  ScratchTile** slot = index != kNotDense ? &dense_[index] : &hashed_[tileKey(tile_x, tile_y)];
   if (*slot == nullptr) {
     if (reached_.size() == pool_.size()) {
       pool_.push_back(std::make_unique<ScratchTile>());
@@ -120,11 +114,7 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
 const ScratchTile* ScanScratch::find(std::uint64_t key) const {
   const std::int32_t x = tileKeyX(key);
   const std::int32_t y = tileKeyY(key);
-  if (dense_tiles_.contains({x, y})) {
-    return dense_[static_cast<std::size_t>(y - dense_tiles_.min.y) *
-                      static_cast<std::size_t>(dense_tiles_.width()) +
-                  static_cast<std::size_t>(x - dense_tiles_.min.x)];
-  }
+  if (denseIndex(x, y) != kNotDense) return denseTile(x, y);
   const auto it = hashed_.find(key);
   return it == hashed_.end() ? nullptr : it->second;
 }
