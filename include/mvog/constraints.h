@@ -58,6 +58,14 @@ class ListMerger {
   /// changed in place (the scan update's commonest case).
   bool keepsUnchanged(VolumeRun negative, VolumeRun obstacles, FreeSpaceRules rules);
 
+  /// Makes `negative` what merge(negative, {}, obstacles, rules, ...) returns: with
+  /// `split_at_obstacles`, a volume reaching into an obstacle is cut at its bottom and top (Sec.
+  /// III-A allows it whole), pieces that touch where no obstacle is join. `negative` is a list
+  /// of Sec. III-A, or one whose obstacles were removed (its volumes touch or lie more than
+  /// kMaxMergeGap apart). Every list a map stores is one the merge keeps, which the in-place
+  /// updates of insertion suppose.
+  void cutAsTheMergeDoes(std::vector<Volume>& negative, VolumeRun obstacles, FreeSpaceRules rules);
+
  private:
   /// A volume whose mass contributes to the merged list (its density is uniform over it).
   struct Source {
@@ -86,6 +94,7 @@ class ListMerger {
   std::vector<Volume> reached_;        // the same, as found by the last sweep
   std::vector<Component> components_;  // upwards
   std::vector<Volume> pieces_;         // keepsUnchanged's cut of one run
+  std::vector<Volume> cut_;            // cutAsTheMergeDoes's result
 };
 
 }  // namespace mvog

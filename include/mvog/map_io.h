@@ -105,7 +105,9 @@ void mergeIntoMapFile(const Map& part, const std::string& path);
 ///   end - 8    8  uint64 FNV-1a 64 checksum of every byte before it
 ///
 /// The size must equal 128 + 8 R + 16 T + 16 C + 12 V + 8, which bounds every count before
-/// anything is allocated; every list must satisfy the constraints under the update's rules.
+/// anything is allocated; every list must satisfy the constraints under the update's rules (a
+/// free list is stored as the merge cuts it, as Map::setCellVolumes stores it: what a source
+/// built by mvog sends already).
 constexpr std::uint32_t kMapUpdateFormatVersion = 1;
 constexpr std::size_t kMapUpdateHeaderBytes = 128;
 

@@ -185,6 +185,15 @@ bool ListMerger::keepsUnchanged(VolumeRun negative, VolumeRun obstacles, FreeSpa
   return true;
 }
 
+void ListMerger::cutAsTheMergeDoes(std::vector<Volume>& negative, VolumeRun obstacles,
+                                   FreeSpaceRules rules) {
+  if (keepsUnchanged(negative, obstacles, rules)) return;
+  // Nothing is added and the volumes touch or lie more than kMaxMergeGap apart: no gap closes,
+  // so no gap mass is needed.
+  merge(negative, {}, obstacles, rules, 0.0f, cut_);
+  negative.swap(cut_);
+}
+
 double ListMerger::massWithin(float bottom, float top) const {
   double mass = 0.0;
   for (const std::vector<Source>* list : {&sources_, &gaps_}) {

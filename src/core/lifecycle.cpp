@@ -230,14 +230,10 @@ ForgetResult Map::forget(double min_mass) {
           result.volumes_removed += removed;
           if (removed_positive && free_space_rules.split_at_obstacles &&
               !edit.kept_negative.empty()) {
-            // Pieces that touched at a removed positive volume merge again. Nothing is added
-            // and the kept volumes touch or lie more than kMaxMergeGap apart: no gap closes, so
-            // no gap mass is needed.
-            edit.merger.merge(edit.kept_negative, {}, edit.positive, free_space_rules, 0.0f,
-                              edit.negative);
-          } else {
-            edit.negative.swap(edit.kept_negative);
+            // Pieces that touched at a removed positive volume merge again.
+            edit.merger.cutAsTheMergeDoes(edit.kept_negative, edit.positive, free_space_rules);
           }
+          edit.negative.swap(edit.kept_negative);
           return true;
         });
     result.cells_emptied += count.cells_emptied;

@@ -218,7 +218,6 @@ void Map::setCellVolumes(const std::vector<CellAssignment>& cells) {
   detail::TileBlock::Builder builder;
   std::vector<Volume> positive;
   std::vector<Volume> negative;
-  std::vector<Volume> cut_negative;
   const FreeSpaceRules free_space_rules = detail::freeSpaceRulesOf(config_.rules);
   ListMerger merger;
   for (std::size_t first = 0; first < by_tile.size();) {
@@ -243,15 +242,7 @@ void Map::setCellVolumes(const std::vector<CellAssignment>& cells) {
         };
         stored(v.positive, positive);
         stored(v.negative, negative);
-        if (free_space_rules.split_at_obstacles &&
-            !merger.keepsUnchanged(negative, positive, free_space_rules)) {
-          // Sec. III-A allows one negative volume across an obstacle; the rule stores it as the
-          // merge cuts it, as every update leaves a list (insertion changes such lists in place,
-          // which supposes it). Nothing is added and the volumes lie more than kMaxMergeGap
-          // apart or touch: no gap closes, so no gap mass is needed.
-          merger.merge(negative, {}, positive, free_space_rules, 0.0f, cut_negative);
-          negative.swap(cut_negative);
-        }
+        merger.cutAsTheMergeDoes(negative, positive, free_space_rules);
         builder.add(local, positive, negative);
         bounds_.extend(CellIndex{origin.x + static_cast<std::int32_t>(local % kTileSize),
                                  origin.y + static_cast<std::int32_t>(local / kTileSize)});

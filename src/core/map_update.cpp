@@ -124,6 +124,8 @@ UpdateBody readBody(const std::uint8_t* data, const UpdateHeader& header) {
   }
   const double max_cell = header.config.max_coordinate / header.config.resolution + 1.0;
   const bool split = header.config.rules.split_free_space_at_obstacles;
+  const FreeSpaceRules free_space_rules = detail::freeSpaceRulesOf(header.config.rules);
+  ListMerger merger;
   std::uint64_t cells_left = header.num_cells;
   std::uint64_t volumes_left = header.num_volumes;
   detail::TileBlock::Builder builder;
@@ -169,6 +171,7 @@ UpdateBody readBody(const std::uint8_t* data, const UpdateHeader& header) {
                       volumes.negative.size(), split);
       if (!invalid.empty()) fail_at_cell(": " + invalid);
       volumes_left -= volumes.positive.size() + volumes.negative.size();
+      merger.cutAsTheMergeDoes(volumes.negative, volumes.positive, free_space_rules);
       builder.add(static_cast<unsigned>(local), volumes.positive, volumes.negative);
     }
     body.tiles.emplace_back(key, builder.finish(static_cast<std::int32_t>(exponent), 0));

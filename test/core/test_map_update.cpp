@@ -383,6 +383,29 @@ TEST(MapUpdate, TheSyncedSmallCaseApplies) {
   EXPECT_TRUE(mirrors(synced.mirror, small.source));
 }
 
+TEST(MapUpdate, AFreeListAcrossAnObstacleIsStoredAsTheMergeCutsIt) {
+  // Sec. III-A allows one free volume across an obstacle. Under split_free_space_at_obstacles
+  // a map stores it cut at the obstacle's bottom and top (as setCellVolumes does), which a
+  // source built by mvog always sends; an update that sends it whole (a source under the paper's
+  // rules, its rules word then saying split) is stored cut too, and the mirror's map is then
+  // one whose file loads back to the same bytes.
+  Map source(test::unitConfig(1000.0, ModelRules::paper()));
+  source.setCellVolumes({3, 4}, CellVolumes{{{2, 3, 1}}, {{0, 10, 5}}});
+  Bytes full = updateOf(source, 0);
+  writeLe(full, 32, readLe(full, 32, 4) | 4u, 4);  // bit 2: split_free_space_at_obstacles
+  fixChecksum(full);
+  MapMirror mirror;
+  ASSERT_EQ(applyTo(mirror, full).status, MapUpdateStatus::kApplied);
+  ASSERT_TRUE(mirror.map().config().rules.split_free_space_at_obstacles);
+  EXPECT_EQ(test::allVolumes(mirror.map()),
+            (std::vector<test::VolumeRecord>{{3, 4, 0, 2.f, 3.f, 1.f},
+                                             {3, 4, 1, 0.f, 2.f, 1.f},
+                                             {3, 4, 1, 2.f, 3.f, 0.5f},
+                                             {3, 4, 1, 3.f, 10.f, 3.5f}}));
+  const Bytes file = serializeMap(mirror.map());
+  EXPECT_EQ(serializeMap(deserializeMap(file.data(), file.size())), file);
+}
+
 TEST(MapUpdate, RefusesCorruptOrForeignBytesChangingNothing) {
   Small small;
   Synced synced(small);
