@@ -114,7 +114,8 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
 const ScratchTile* ScanScratch::find(std::uint64_t key) const {
   const std::int32_t x = tileKeyX(key);
   const std::int32_t y = tileKeyY(key);
-  if (denseIndex(x, y) != kNotDense) return denseTile(x, y);
+  const std::size_t index = denseIndex(x, y);
+  if (index != kNotDense) return dense_[index];
   const auto it = hashed_.find(key);
   return it == hashed_.end() ? nullptr : it->second;
 }

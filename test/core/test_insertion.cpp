@@ -424,14 +424,11 @@ TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
     std::vector<std::vector<Volume>> negative(4);
     ListMerger merger;
     const FreeSpaceRules free_space_rules{rules.split_free_space_at_obstacles, false};
-    // Merges `added` (none, one volume) into a cell's lists as a reading does.
-    auto insert_into = [&](int c, std::vector<Volume>& list, VolumeRun added) {
+    // Merges `added` (none, one volume) into one list of a cell as a reading does.
+    auto insert_into = [&](std::vector<Volume>& list, VolumeRun added, VolumeRun obstacles,
+                           FreeSpaceRules list_rules) {
       std::vector<Volume> out;
-      if (&list == &positive[c]) {
-        merger.merge(list, added, {}, {}, 1.0f, out);
-      } else {
-        merger.merge(list, added, positive[c], free_space_rules, 1.0f, out);
-      }
+      merger.merge(list, added, obstacles, list_rules, 1.0f, out);
       list = out;
     };
     // Short rays at one of 8 levels 12 apart: volumes of one level merge, different levels stay
@@ -460,12 +457,13 @@ TEST(Insertion, CellsHoldExactlyWhatTheListRulesGive) {
       const auto end_z = static_cast<float>(z1);
       if (obstacle) {
         const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
-        insert_into(c, positive[c], VolumeRun(&hit, 1));
+        insert_into(positive[c], VolumeRun(&hit, 1), {}, {});
         const Volume free = makeVolume(start_z, z0 < z1 ? hit.bottom : hit.top);
-        insert_into(c, negative[c], VolumeRun(&free, std::fabs(z0 - z1) > 1.0 ? 1 : 0));
+        insert_into(negative[c], VolumeRun(&free, std::fabs(z0 - z1) > 1.0 ? 1 : 0), positive[c],
+                    free_space_rules);
       } else {
         const Volume free = makeVolume(start_z, end_z);
-        insert_into(c, negative[c], VolumeRun(&free, 1));
+        insert_into(negative[c], VolumeRun(&free, 1), positive[c], free_space_rules);
       }
       const CellVolumes held = map.cellVolumes({c % 2, c / 2});
       ASSERT_TRUE(sameBits(held.positive, positive[c]))
