@@ -30,19 +30,26 @@ struct ScanInterval {
   double mass;
 };
 
-/// A column's free space so far in one scan: the interval its last ray reached inline, with the
-/// nearest of its other intervals below and above (kept aside, if any), so that the next ray,
-/// which mostly reaches the same interval, grows it inline.
+/// A column's free space so far in one scan: the interval its last ray reached inline, so that
+/// the next ray, which mostly reaches the same interval, grows it inline. 16 bytes: a scan's
+/// slots are most of what its rasterisation reads and writes.
 struct FreeSlot {
   float bottom;
   float top;
-  float below;  ///< top of the next interval below, or -infinity
-  float above;  ///< bottom of the next interval above, or +infinity
   /// The stamp of the scan the slot holds (so that no slot needs clearing between scans).
   std::uint32_t stamp;
-  std::uint32_t others;  ///< index of the other intervals kept aside, or kNoOthers
+  std::uint32_t others;  ///< index of the column's other intervals (OtherIntervals), or kNoOthers
 };
+static_assert(sizeof(FreeSlot) == 16, "four slots a cache line");
 constexpr std::uint32_t kNoOthers = 0xffffffffu;
+
+/// The intervals of a column with several, but for the one inline in its slot (sorted), and the
+/// nearest of them below and above the inline one, which the next ray may grow it up to.
+struct OtherIntervals {
+  std::vector<ScanInterval> intervals;
+  float below;  ///< top of the next interval below the inline one, or -infinity
+  float above;  ///< bottom of the next interval above it, or +infinity
+};
 
 /// A hit's positive volume (eq. 5) in a cell of a tile.
 struct TileHit {
@@ -90,16 +97,13 @@ class ScanScratch {
       const unsigned local = localIndex(cell);
       FreeSlot& slot = tile.slots[local];
       if (slot.stamp != stamp_) {  // the cell's first interval of this scan
-        constexpr float kInfinity = std::numeric_limits<float>::infinity();
-        slot = {volume.bottom, volume.top, -kInfinity, kInfinity, stamp_, kNoOthers};
+        slot = {volume.bottom, volume.top, stamp_, kNoOthers};
         if (kCountMasses) tile.masses[local] = volume.mass;
         tile.markReached(local);
         return;
       }
-      // A slot without other intervals has none below or above to reach (they are infinite).
       if (std::max(volume.bottom - slot.top, slot.bottom - volume.top) <= join_gap_ &&
-          (slot.others == kNoOthers ||
-           std::min(volume.bottom - slot.below, slot.above - volume.top) > join_gap_)) {
+          slot.others == kNoOthers) {
         slot.bottom = std::min(slot.bottom, volume.bottom);
         slot.top = std::max(slot.top, volume.top);
         if (kCountMasses) tile.masses[local] += volume.mass;
@@ -172,7 +176,8 @@ class ScanScratch {
     return index == kNotDense ? nullptr : dense_[index];
   }
   ScratchTile& findOrAddTile(std::int32_t tile_x, std::int32_t tile_y);
-  /// An interval that does more than grow the inline interval of a slot of this scan.
+  /// An interval that does more than grow the inline interval of a slot of this scan and
+  /// column that holds no other interval.
   void addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume);
 
   /// The tiles reached, by key, and the index from tile to scratch: dense over the scan's tiles
@@ -186,8 +191,8 @@ class ScanScratch {
   std::vector<ScratchTile*> dense_;
   std::unordered_map<std::uint64_t, ScratchTile*> hashed_;
   std::vector<std::unique_ptr<ScratchTile>> pool_;
-  /// The intervals of columns with several, but for the one inline (sorted).
-  std::vector<std::vector<ScanInterval>> others_;
+  /// The other intervals of columns with several.
+  std::vector<OtherIntervals> others_;
   std::size_t others_used_ = 0;
   std::uint32_t stamp_ = 0;
   float join_gap_ = 0.0f;

@@ -94,10 +94,19 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
   if (slot.others == kNoOthers) {
     if (others_used_ == others_.size()) others_.emplace_back();
     slot.others = static_cast<std::uint32_t>(others_used_++);
-    others_[slot.others].clear();
+    others_[slot.others].intervals.clear();
+  } else if (std::max(volume.bottom - slot.top, slot.bottom - volume.top) <= join_gap_ &&
+             std::min(volume.bottom - others_[slot.others].below,
+                      others_[slot.others].above - volume.top) > join_gap_) {
+    // It grows the inline interval and reaches none of the others.
+    slot.bottom = std::min(slot.bottom, volume.bottom);
+    slot.top = std::max(slot.top, volume.top);
+    if (count_masses_) tile.masses[local] += mass;
+    return;
   }
   // Join the volume into all of the cell's intervals, then keep the one it reached inline.
-  std::vector<ScanInterval>& list = others_[slot.others];
+  OtherIntervals& others = others_[slot.others];
+  std::vector<ScanInterval>& list = others.intervals;
   const ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
   list.insert(std::partition_point(list.begin(), list.end(),
                                    [&](const ScanInterval& i) { return i.top < current.bottom; }),
@@ -107,8 +116,8 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
   slot.top = list[k].top;
   tile.masses[local] = list[k].mass;
   list.erase(list.begin() + static_cast<std::ptrdiff_t>(k));
-  slot.below = k > 0 ? list[k - 1].top : -kInfinity;
-  slot.above = k < list.size() ? list[k].bottom : kInfinity;
+  others.below = k > 0 ? list[k - 1].top : -kInfinity;
+  others.above = k < list.size() ? list[k].bottom : kInfinity;
 }
 
 const ScratchTile* ScanScratch::find(std::uint64_t key) const {
@@ -129,7 +138,7 @@ void ScanScratch::appendFree(const ScratchTile& tile, unsigned local,
     out.push_back(current);
     return;
   }
-  const std::vector<ScanInterval>& list = others_[slot.others];
+  const std::vector<ScanInterval>& list = others_[slot.others].intervals;
   bool placed = false;
   for (const ScanInterval& i : list) {
     if (!placed && current.bottom < i.bottom) {
