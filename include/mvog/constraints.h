@@ -73,19 +73,25 @@ class ListMerger {
     float top;
     double mass;
   };
-  /// A run of the merged list before it is cut, with the obstacles [first, end) of inside_ in it.
+  /// A run of the merged list before it is cut, with the obstacles [first, end) of inside_ in it,
+  /// and its sources and gaps (no other source or gap reaches into it).
   struct Component {
     float bottom;
     float top;
     std::size_t first_inside;
     std::size_t end_inside;
+    std::size_t first_source;
+    std::size_t end_source;
+    std::size_t first_gap;
+    std::size_t end_gap;
   };
   void sweep();
   /// Appends the pieces of the component [bottom, top] cut at the obstacles within it.
   static void cutAtObstacles(float bottom, float top, const Volume* first_obstacle,
                              const Volume* end_obstacle, std::vector<Volume>& out);
   void addPieces(const Component& component, std::vector<Volume>& out) const;
-  double massWithin(float bottom, float top) const;
+  /// The mass of `component`'s sources and gaps within [bottom, top].
+  double massWithin(const Component& component, float bottom, float top) const;
 
   std::vector<Source> sources_;        // sorted by (bottom, top, mass)
   std::vector<Source> added_;          // the added volumes, sorted

@@ -91,7 +91,8 @@ void ListMerger::sweep() {
     const float bottom = take_inside ? inside_[next_inside].bottom : sources_[next_source].bottom;
     const float top = take_inside ? inside_[next_inside].top : sources_[next_source].top;
     if (components_.empty() || !mustMerge(components_.back().top, bottom)) {
-      components_.push_back({bottom, top, next_inside, next_inside});
+      components_.push_back({bottom, top, next_inside, next_inside, next_source, next_source,
+                             gaps_.size(), gaps_.size()});
       has_source = false;
     } else {
       components_.back().top = std::max(components_.back().top, top);
@@ -102,10 +103,11 @@ void ListMerger::sweep() {
     }
     if (has_source && bottom > sources_top && mustMerge(sources_top, bottom)) {
       gaps_.push_back({sources_top, bottom, 0.0});
+      components_.back().end_gap = gaps_.size();
     }
     sources_top = has_source ? std::max(sources_top, top) : top;
     has_source = true;
-    ++next_source;
+    components_.back().end_source = ++next_source;
   }
 }
 
@@ -142,7 +144,7 @@ void ListMerger::addPieces(const Component& component, std::vector<Volume>& out)
   cutAtObstacles(component.bottom, component.top, inside_.data() + component.first_inside,
                  inside_.data() + component.end_inside, out);
   for (std::size_t k = first_piece; k < out.size(); ++k) {
-    out[k].mass = static_cast<float>(massWithin(out[k].bottom, out[k].top));
+    out[k].mass = static_cast<float>(massWithin(component, out[k].bottom, out[k].top));
   }
 }
 
@@ -194,11 +196,14 @@ void ListMerger::cutAsTheMergeDoes(std::vector<Volume>& negative, VolumeRun obst
   negative.swap(cut_);
 }
 
-double ListMerger::massWithin(float bottom, float top) const {
+double ListMerger::massWithin(const Component& component, float bottom, float top) const {
+  // Only the component's own sources and gaps: the others lie more than kMaxMergeGap away and
+  // would add nothing, while a column of many components would make the merge quadratic.
   double mass = 0.0;
-  for (const std::vector<Source>* list : {&sources_, &gaps_}) {
-    for (const Source& s : *list) {
-      if (s.bottom >= top) break;  // both lists run upwards
+  auto add_within = [&](const std::vector<Source>& list, std::size_t first, std::size_t end) {
+    for (std::size_t k = first; k < end; ++k) {
+      const Source& s = list[k];
+      if (s.bottom >= top) break;  // the list runs upwards
       if (s.bottom >= bottom && s.top <= top) {
         mass += s.mass;
         continue;
@@ -206,7 +211,9 @@ double ListMerger::massWithin(float bottom, float top) const {
       const double overlap = static_cast<double>(std::min(top, s.top)) - std::max(bottom, s.bottom);
       if (overlap > 0.0) mass += s.mass * overlap / (static_cast<double>(s.top) - s.bottom);
     }
-  }
+  };
+  add_within(sources_, component.first_source, component.end_source);
+  add_within(gaps_, component.first_gap, component.end_gap);
   return mass;
 }
 
