@@ -114,6 +114,17 @@ class ScanScratch {
     void addHit(const CellIndex& cell, const Volume& volume) {
       ScratchTile& tile = tileFor(cell);
       const unsigned local = localIndex(cell);
+      // Counted per scan, a column's hits count by the heights they cover: one joining the
+      // tile's last hit (a depth camera's neighbouring pixels mostly hit one cell at one height)
+      // grows it, which applying the scan, joining the cell's hits, would do anyway.
+      if (!kCountMasses && !tile.hits.empty() && tile.hits.back().local == local &&
+          std::max(volume.bottom - tile.hits.back().top, tile.hits.back().bottom - volume.top) <=
+              join_gap_) {
+        TileHit& last = tile.hits.back();
+        last.bottom = std::min(last.bottom, volume.bottom);
+        last.top = std::max(last.top, volume.top);
+        return;
+      }
       tile.hits.push_back({static_cast<std::uint16_t>(local), volume.bottom, volume.top});
       tile.markReached(local);
     }
