@@ -112,21 +112,7 @@ class ScanScratch {
       scratch_.addFreeSlow(tile, local, volume);
     }
     void addHit(const CellIndex& cell, const Volume& volume) {
-      ScratchTile& tile = tileFor(cell);
-      const unsigned local = localIndex(cell);
-      // Counted per scan, a column's hits count by the heights they cover: one joining the
-      // tile's last hit (a depth camera's neighbouring pixels mostly hit one cell at one height)
-      // grows it, which applying the scan, joining the cell's hits, would do anyway.
-      if (!kCountMasses && !tile.hits.empty() && tile.hits.back().local == local &&
-          std::max(volume.bottom - tile.hits.back().top, tile.hits.back().bottom - volume.top) <=
-              join_gap_) {
-        TileHit& last = tile.hits.back();
-        last.bottom = std::min(last.bottom, volume.bottom);
-        last.top = std::max(last.top, volume.top);
-        return;
-      }
-      tile.hits.push_back({static_cast<std::uint16_t>(local), volume.bottom, volume.top});
-      tile.markReached(local);
+      scratch_.addHit(tileFor(cell), localIndex(cell), volume);
     }
 
    private:
@@ -187,6 +173,8 @@ class ScanScratch {
     return index == kNotDense ? nullptr : dense_[index];
   }
   ScratchTile& findOrAddTile(std::int32_t tile_x, std::int32_t tile_y);
+  /// A hit's volume in cell `local` of `tile` (out of line: once a ray, not in its walk's loop).
+  void addHit(ScratchTile& tile, unsigned local, const Volume& volume);
   /// An interval that does more than grow the inline interval of a slot of this scan and
   /// column that holds no other interval.
   void addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume);

@@ -120,6 +120,22 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
   others.above = k < list.size() ? list[k].bottom : kInfinity;
 }
 
+void ScanScratch::addHit(ScratchTile& tile, unsigned local, const Volume& volume) {
+  // Counted per scan, a column's hits count by the heights they cover: one joining the tile's
+  // last hit (a depth camera's neighbouring pixels mostly hit one cell at one height) grows it,
+  // which applying the scan, joining the cell's hits, would do anyway.
+  if (!count_masses_ && !tile.hits.empty() && tile.hits.back().local == local &&
+      std::max(volume.bottom - tile.hits.back().top, tile.hits.back().bottom - volume.top) <=
+          join_gap_) {
+    TileHit& last = tile.hits.back();
+    last.bottom = std::min(last.bottom, volume.bottom);
+    last.top = std::max(last.top, volume.top);
+    return;
+  }
+  tile.hits.push_back({static_cast<std::uint16_t>(local), volume.bottom, volume.top});
+  tile.markReached(local);
+}
+
 const ScratchTile* ScanScratch::find(std::uint64_t key) const {
   const std::int32_t x = tileKeyX(key);
   const std::int32_t y = tileKeyY(key);
