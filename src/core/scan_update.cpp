@@ -427,18 +427,28 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
     auto mine = [&](std::size_t k) {
       return num_threads == 1 || impl.split.chunk_of_reading[k] == chunk;
     };
-    // The tiles of the chunk's rays (those it may accept) for the scratch's dense index.
-    CellRange tiles = kNoCells;
+    // The tiles of the chunk's rays (those it may accept) for the scratch's dense index: those
+    // of the corners of their points' bounding box (a cell's index grows with its coordinates).
+    Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector2d high = -low;
     auto reach = [&](const Eigen::Vector3d& p) {
       if (!map_config.withinBounds(p)) return;
-      const CellIndex cell = cellAt(p.x() * s, p.y() * s);
-      tiles.extend(CellIndex{cell.x >> detail::kTileSizeLog2, cell.y >> detail::kTileSizeLog2});
+      low = low.cwiseMin(p.head<2>());
+      high = high.cwiseMax(p.head<2>());
     };
     reach(scan.origin);
     for (std::size_t k = 0; k < num_readings; ++k) {
       if (mine(k)) {
         reach((k < num_hits ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>());
       }
+    }
+    CellRange tiles = kNoCells;
+    if (low.x() <= high.x()) {
+      auto tile_of = [&](const Eigen::Vector2d& p) {
+        const CellIndex cell = cellAt(p.x() * s, p.y() * s);
+        return CellIndex{cell.x >> detail::kTileSizeLog2, cell.y >> detail::kTileSizeLog2};
+      };
+      tiles = {tile_of(low), tile_of(high)};
     }
     const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
     scratch.begin(detail::joinGapOf(map_config.rules), count_masses, tiles);
