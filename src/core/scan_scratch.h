@@ -75,6 +75,12 @@ inline bool joins(float lower_top, float upper_bottom, float join_gap) {
   return upper_bottom - lower_top <= join_gap;
 }
 
+/// Whether two intervals, in either order, join: they overlap, or lie at most `join_gap` apart.
+inline bool intervalsJoin(float bottom, float top, float other_bottom, float other_top,
+                          float join_gap) {
+  return std::max(bottom - other_top, other_bottom - top) <= join_gap;
+}
+
 /// One thread's part of a scan: the tiles its readings reached.
 class ScanScratch {
  public:
@@ -102,7 +108,7 @@ class ScanScratch {
         tile.markReached(local);
         return;
       }
-      if (std::max(volume.bottom - slot.top, slot.bottom - volume.top) <= join_gap_ &&
+      if (intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_) &&
           slot.others == kNoOthers) {
         slot.bottom = std::min(slot.bottom, volume.bottom);
         slot.top = std::max(slot.top, volume.top);

@@ -95,7 +95,7 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
     if (others_used_ == others_.size()) others_.emplace_back();
     slot.others = static_cast<std::uint32_t>(others_used_++);
     others_[slot.others].intervals.clear();
-  } else if (std::max(volume.bottom - slot.top, slot.bottom - volume.top) <= join_gap_ &&
+  } else if (intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_) &&
              std::min(volume.bottom - others_[slot.others].below,
                       others_[slot.others].above - volume.top) > join_gap_) {
     // It grows the inline interval and reaches none of the others.
@@ -125,8 +125,8 @@ void ScanScratch::addHit(ScratchTile& tile, unsigned local, const Volume& volume
   // last hit (a depth camera's neighbouring pixels mostly hit one cell at one height) grows it,
   // which applying the scan, joining the cell's hits, would do anyway.
   if (!count_masses_ && !tile.hits.empty() && tile.hits.back().local == local &&
-      std::max(volume.bottom - tile.hits.back().top, tile.hits.back().bottom - volume.top) <=
-          join_gap_) {
+      intervalsJoin(volume.bottom, volume.top, tile.hits.back().bottom, tile.hits.back().top,
+                    join_gap_)) {
     TileHit& last = tile.hits.back();
     last.bottom = std::min(last.bottom, volume.bottom);
     last.top = std::max(last.top, volume.top);
