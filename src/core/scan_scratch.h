@@ -36,12 +36,18 @@ struct ScanInterval {
 struct FreeSlot {
   float bottom;
   float top;
-  /// The stamp of the scan the slot holds (so that no slot needs clearing between scans).
-  std::uint32_t stamp;
-  std::uint32_t others;  ///< index of the column's other intervals (OtherIntervals), or kNoOthers
+  /// The stamp of the scan the slot holds (so that no slot needs clearing between scans), and
+  /// the index of the column's other intervals (OtherIntervals) or kNoOthers: one word, which
+  /// the commonest visit (a slot of this scan without others) tests at once (slotTag).
+  std::uint64_t tag;
+  std::uint32_t stamp() const { return static_cast<std::uint32_t>(tag); }
+  std::uint32_t others() const { return static_cast<std::uint32_t>(tag >> 32); }
 };
 static_assert(sizeof(FreeSlot) == 16, "four slots a cache line");
 constexpr std::uint32_t kNoOthers = 0xffffffffu;
+inline std::uint64_t slotTag(std::uint32_t stamp, std::uint32_t others) {
+  return stamp | std::uint64_t{others} << 32;
+}
 
 /// The intervals of a column with several, but for the one inline in its slot (sorted), and the
 /// nearest of them below and above the inline one, which the next ray may grow it up to.
@@ -95,24 +101,27 @@ class ScanScratch {
   class Writer {
    public:
     explicit Writer(ScanScratch& scratch)
-        : scratch_(scratch), stamp_(scratch.stamp_), join_gap_(scratch.join_gap_) {}
+        : scratch_(scratch),
+          stamp_(scratch.stamp_),
+          inline_only_(slotTag(scratch.stamp_, kNoOthers)),
+          join_gap_(scratch.join_gap_) {}
     /// Called for every cell a ray crosses: the commonest case (the interval inline grows and
     /// reaches no other) stays inline in the ray walk.
     void addFree(const CellIndex& cell, const Volume& volume) {
       ScratchTile& tile = tileFor(cell);
       const unsigned local = localIndex(cell);
       FreeSlot& slot = tile.slots[local];
-      if (slot.stamp != stamp_) {  // the cell's first interval of this scan
-        slot = {volume.bottom, volume.top, stamp_, kNoOthers};
+      if (slot.tag == inline_only_) {
+        if (intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_)) {
+          slot.bottom = std::min(slot.bottom, volume.bottom);
+          slot.top = std::max(slot.top, volume.top);
+          if (kCountMasses) tile.masses[local] += volume.mass;
+          return;
+        }
+      } else if (slot.stamp() != stamp_) {  // the cell's first interval of this scan
+        slot = {volume.bottom, volume.top, inline_only_};
         if (kCountMasses) tile.masses[local] = volume.mass;
         tile.markReached(local);
-        return;
-      }
-      if (intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_) &&
-          slot.others == kNoOthers) {
-        slot.bottom = std::min(slot.bottom, volume.bottom);
-        slot.top = std::max(slot.top, volume.top);
-        if (kCountMasses) tile.masses[local] += volume.mass;
         return;
       }
       scratch_.addFreeSlow(tile, local, volume);
@@ -137,6 +146,7 @@ class ScanScratch {
 
     ScanScratch& scratch_;
     const std::uint32_t stamp_;
+    const std::uint64_t inline_only_;  ///< the tag of a slot of this scan without others
     const float join_gap_;
     ScratchTile* tile_ = nullptr;
     // No tile yet: no cell within MapConfig's bounds (2^22 cells) is in tile x = INT32_MIN.
@@ -150,12 +160,12 @@ class ScanScratch {
   const std::vector<std::pair<std::uint64_t, ScratchTile*>>& tiles() const { return reached_; }
   /// Whether this scan's rays reached cell `local` of `tile`.
   bool reached(const ScratchTile& tile, unsigned local) const {
-    return tile.slots[local].stamp == stamp_;
+    return tile.slots[local].stamp() == stamp_;
   }
   /// Whether cell `local` of `tile` holds exactly one free interval; if so, sets it.
   bool singleFree(const ScratchTile& tile, unsigned local, ScanInterval& interval) const {
     const FreeSlot& slot = tile.slots[local];
-    if (slot.stamp != stamp_ || slot.others != kNoOthers) return false;
+    if (slot.tag != slotTag(stamp_, kNoOthers)) return false;
     interval = {slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
     return true;
   }

@@ -65,7 +65,7 @@ void ScanScratch::begin(float join_gap, bool count_masses, const CellRange& tile
   dense_.assign(std::size_t{dense_width_} * dense_height_, nullptr);
   if (++stamp_ == 0) {  // after 2^32 scans: no slot may keep the new stamp from long ago
     for (auto& tile : pool_) {
-      for (FreeSlot& slot : tile->slots) slot.stamp = 0;
+      for (FreeSlot& slot : tile->slots) slot.tag = 0;
     }
     stamp_ = 1;
   }
@@ -77,7 +77,7 @@ ScratchTile& ScanScratch::findOrAddTile(std::int32_t tile_x, std::int32_t tile_y
   if (*slot == nullptr) {
     if (reached_.size() == pool_.size()) {
       pool_.push_back(std::make_unique<ScratchTile>());
-      for (FreeSlot& s : pool_.back()->slots) s.stamp = 0;
+      for (FreeSlot& s : pool_.back()->slots) s.tag = 0;
     }
     *slot = pool_[reached_.size()].get();
     (*slot)->hits.clear();
@@ -91,13 +91,13 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
   FreeSlot& slot = tile.slots[local];
   const double mass = count_masses_ ? static_cast<double>(volume.mass) : 0.0;
-  if (slot.others == kNoOthers) {
+  if (slot.others() == kNoOthers) {
     if (others_used_ == others_.size()) others_.emplace_back();
-    slot.others = static_cast<std::uint32_t>(others_used_++);
-    others_[slot.others].intervals.clear();
+    slot.tag = slotTag(stamp_, static_cast<std::uint32_t>(others_used_++));
+    others_[slot.others()].intervals.clear();
   } else if (intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_) &&
-             std::min(volume.bottom - others_[slot.others].below,
-                      others_[slot.others].above - volume.top) > join_gap_) {
+             std::min(volume.bottom - others_[slot.others()].below,
+                      others_[slot.others()].above - volume.top) > join_gap_) {
     // It grows the inline interval and reaches none of the others.
     slot.bottom = std::min(slot.bottom, volume.bottom);
     slot.top = std::max(slot.top, volume.top);
@@ -105,7 +105,7 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
     return;
   }
   // Join the volume into all of the cell's intervals, then keep the one it reached inline.
-  OtherIntervals& others = others_[slot.others];
+  OtherIntervals& others = others_[slot.others()];
   std::vector<ScanInterval>& list = others.intervals;
   const ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
   list.insert(std::partition_point(list.begin(), list.end(),
@@ -148,13 +148,13 @@ const ScratchTile* ScanScratch::find(std::uint64_t key) const {
 void ScanScratch::appendFree(const ScratchTile& tile, unsigned local,
                              std::vector<ScanInterval>& out) const {
   const FreeSlot& slot = tile.slots[local];
-  if (slot.stamp != stamp_) return;
+  if (slot.stamp() != stamp_) return;
   const ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
-  if (slot.others == kNoOthers) {
+  if (slot.others() == kNoOthers) {
     out.push_back(current);
     return;
   }
-  const std::vector<ScanInterval>& list = others_[slot.others].intervals;
+  const std::vector<ScanInterval>& list = others_[slot.others()].intervals;
   bool placed = false;
   for (const ScanInterval& i : list) {
     if (!placed && current.bottom < i.bottom) {
