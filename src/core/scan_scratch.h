@@ -42,6 +42,11 @@ struct FreeSlot {
   std::uint64_t tag;
   std::uint32_t stamp() const { return static_cast<std::uint32_t>(tag); }
   std::uint32_t others() const { return static_cast<std::uint32_t>(tag >> 32); }
+  /// Grows the inline interval to hold `volume`.
+  void grow(const Volume& volume) {
+    bottom = std::min(bottom, volume.bottom);
+    top = std::max(top, volume.top);
+  }
 };
 static_assert(sizeof(FreeSlot) == 16, "four slots a cache line");
 constexpr std::uint32_t kNoOthers = 0xffffffffu;
@@ -113,8 +118,7 @@ class ScanScratch {
       FreeSlot& slot = tile.slots[local];
       if (slot.tag == inline_only_) {
         if (intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_)) {
-          slot.bottom = std::min(slot.bottom, volume.bottom);
-          slot.top = std::max(slot.top, volume.top);
+          slot.grow(volume);
           if (kCountMasses) tile.masses[local] += volume.mass;
           return;
         }

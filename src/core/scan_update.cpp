@@ -95,12 +95,11 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
     if (others_used_ == others_.size()) others_.emplace_back();
     slot.tag = slotTag(stamp_, static_cast<std::uint32_t>(others_used_++));
     others_[slot.others()].intervals.clear();
-  } else if (intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_) &&
-             std::min(volume.bottom - others_[slot.others()].below,
-                      others_[slot.others()].above - volume.top) > join_gap_) {
+  } else if (const OtherIntervals& others = others_[slot.others()];
+             intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_) &&
+             std::min(volume.bottom - others.below, others.above - volume.top) > join_gap_) {
     // It grows the inline interval and reaches none of the others.
-    slot.bottom = std::min(slot.bottom, volume.bottom);
-    slot.top = std::max(slot.top, volume.top);
+    slot.grow(volume);
     if (count_masses_) tile.masses[local] += mass;
     return;
   }
