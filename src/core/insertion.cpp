@@ -105,7 +105,9 @@ void gatherTile(std::uint64_t key, const std::vector<detail::ScanScratch>& scrat
     if (const detail::ScratchTile* part = scratch.find(key)) {
       work.parts.emplace_back(&scratch, part);
       work.hits.insert(work.hits.end(), part->hits.begin(), part->hits.end());
-      for (std::size_t w = 0; w < std::size(work.reached); ++w) work.reached[w] |= part->reached[w];
+      for (std::size_t w = 0; w < std::size(work.reached); ++w) {
+        work.reached[w] |= part->reached[w] | part->level_free[w];
+      }
     }
   }
   // A tile mostly holds a few hits: sorted as they are. Many (a dense camera's) are first

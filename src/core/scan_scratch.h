@@ -74,10 +74,17 @@ struct ScratchTile {
   /// With MassCounting::kPerReading: the mass of each slot's inline interval.
   double masses[kCellsPerTile];
   std::vector<TileHit> hits;
-  /// Bit k: cell k got something in this scan (so that applying visits only those).
+  /// Bit k: cell k got a hit, or (but in a level scan) free space in this scan (so that applying
+  /// visits only those).
   std::uint64_t reached[kCellsPerTile / 64];
+  /// In a level scan (ScanScratch::begin): bit k, cell k got the scan's one free volume.
+  std::uint64_t level_free[kCellsPerTile / 64];
 
   void markReached(unsigned local) { reached[local >> 6] |= std::uint64_t{1} << (local & 63); }
+  void markLevelFree(unsigned local) { level_free[local >> 6] |= std::uint64_t{1} << (local & 63); }
+  bool levelFree(unsigned local) const {
+    return ((level_free[local >> 6] >> (local & 63)) & 1u) != 0;
+  }
 };
 
 /// Whether two intervals, one not below the other, join: the upper one's bottom is at most
@@ -98,11 +105,14 @@ class ScanScratch {
   /// Forgets the previous scan (its memory is kept for the next). Intervals less than
   /// `join_gap` apart will join (0: only overlapping or touching ones); masses are summed only
   /// if `count_masses`. The readings will stay within the tiles of `tiles` if it is not empty.
-  void begin(float join_gap, bool count_masses, const CellRange& tiles);
+  /// A level scan (`level` not null, masses not counted) gives every cell it frees the one free
+  /// volume `*level`: the scratch keeps one bit a cell (Writer<false, true>).
+  void begin(float join_gap, bool count_masses, const CellRange& tiles,
+             const Volume* level = nullptr);
 
   /// Adds one scan's volumes to the scratch; kept by one ray walk, so that what every cell
-  /// visit needs stays in registers.
-  template <bool kCountMasses>
+  /// visit needs stays in registers. kLevel: the writer of a level scan (see begin).
+  template <bool kCountMasses, bool kLevel = false>
   class Writer {
    public:
     explicit Writer(ScanScratch& scratch)
@@ -115,6 +125,11 @@ class ScanScratch {
     void addFree(const CellIndex& cell, const Volume& volume) {
       ScratchTile& tile = tileFor(cell);
       const unsigned local = localIndex(cell);
+      if constexpr (kLevel) {  // every free volume of the scan is the level one
+        static_assert(!kCountMasses, "a level scan's cells hold no masses");
+        tile.markLevelFree(local);
+        return;
+      }
       FreeSlot& slot = tile.slots[local];
       if (slot.tag == inline_only_) {
         if (intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_)) {
@@ -162,12 +177,12 @@ class ScanScratch {
   const ScratchTile* find(std::uint64_t key) const;
   /// Every tile this scan reached, by key.
   const std::vector<std::pair<std::uint64_t, ScratchTile*>>& tiles() const { return reached_; }
-  /// Whether this scan's rays reached cell `local` of `tile`.
-  bool reached(const ScratchTile& tile, unsigned local) const {
-    return tile.slots[local].stamp() == stamp_;
-  }
   /// Whether cell `local` of `tile` holds exactly one free interval; if so, sets it.
   bool singleFree(const ScratchTile& tile, unsigned local, ScanInterval& interval) const {
+    if (level_) {
+      interval = {level_volume_.bottom, level_volume_.top, 0.0};
+      return tile.levelFree(local);
+    }
     const FreeSlot& slot = tile.slots[local];
     if (slot.tag != slotTag(stamp_, kNoOthers)) return false;
     interval = {slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
@@ -216,6 +231,9 @@ class ScanScratch {
   std::uint32_t stamp_ = 0;
   float join_gap_ = 0.0f;
   bool count_masses_ = false;
+  /// A level scan, and its one free volume (see begin).
+  bool level_ = false;
+  Volume level_volume_{};
 };
 
 /// Joins [bottom, top] into the sorted `list` of intervals more than `join_gap` apart; returns

@@ -51,9 +51,12 @@ void joinSorted(std::vector<ScanInterval>& intervals, float join_gap) {
 /// (a far reading) indexes its tiles in a hash map.
 constexpr std::int64_t kMaxDenseTiles = std::int64_t{1} << 16;
 
-void ScanScratch::begin(float join_gap, bool count_masses, const CellRange& tiles) {
+void ScanScratch::begin(float join_gap, bool count_masses, const CellRange& tiles,
+                        const Volume* level) {
   join_gap_ = join_gap;
   count_masses_ = count_masses;
+  level_ = level != nullptr && !count_masses;
+  level_volume_ = level_ ? *level : Volume{};
   reached_.clear();
   hashed_.clear();
   others_used_ = 0;
@@ -82,6 +85,7 @@ ScratchTile& ScanScratch::findOrAddTile(std::int32_t tile_x, std::int32_t tile_y
     *slot = pool_[reached_.size()].get();
     (*slot)->hits.clear();
     std::fill(std::begin((*slot)->reached), std::end((*slot)->reached), std::uint64_t{0});
+    std::fill(std::begin((*slot)->level_free), std::end((*slot)->level_free), std::uint64_t{0});
     reached_.emplace_back(tileKey(tile_x, tile_y), *slot);
   }
   return **slot;
@@ -146,6 +150,10 @@ const ScratchTile* ScanScratch::find(std::uint64_t key) const {
 
 void ScanScratch::appendFree(const ScratchTile& tile, unsigned local,
                              std::vector<ScanInterval>& out) const {
+  if (level_) {
+    if (tile.levelFree(local)) out.push_back({level_volume_.bottom, level_volume_.top, 0.0});
+    return;
+  }
   const FreeSlot& slot = tile.slots[local];
   if (slot.stamp() != stamp_) return;
   const ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
@@ -435,10 +443,16 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
       low = low.cwiseMin(p.head<2>());
       high = high.cwiseMax(p.head<2>());
     };
+    // A level scan: every reading at the origin's height (a level 2D laser's), each of whose
+    // rays then frees the same volume in every cell it crosses (addReading's level ray).
+    bool level = true;
     reach(scan.origin);
     for (std::size_t k = 0; k < num_readings; ++k) {
       if (mine(k)) {
-        reach((k < num_hits ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>());
+        const Eigen::Vector3d p =
+            (k < num_hits ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>();
+        reach(p);
+        level = level && p.z() == scan.origin.z();
       }
     }
     CellRange tiles = kNoCells;
@@ -450,9 +464,16 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
       tiles = {tile_of(low), tile_of(high)};
     }
     const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
-    scratch.begin(detail::joinGapOf(map_config.rules), count_masses, tiles);
+    const auto level_height = static_cast<float>(scan.origin.z() * s);
+    const Volume level_volume = makeVolume(level_height, level_height);
+    level = level && !count_masses && insertion.model_negative_space;
+    scratch.begin(detail::joinGapOf(map_config.rules), count_masses, tiles,
+                  level ? &level_volume : nullptr);
     if (count_masses) {
       detail::ScanScratch::Writer<true> writer(scratch);
+      detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
+    } else if (level) {
+      detail::ScanScratch::Writer<false, true> writer(scratch);
       detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
     } else {
       detail::ScanScratch::Writer<false> writer(scratch);
