@@ -51,8 +51,12 @@ mvog::Scan laserScanToScan(const sensor_msgs::LaserScan& scan,
     throw InvalidMessage("LaserScan range limits must be finite with 0 <= range_min < range_max");
   }
   const double free_range = std::min<double>(scan.range_max, max_free_range);
+  // The sensor's height in float, as its points' heights are: a level laser's points then lie
+  // at its height exactly, and the map inserts the scan as a level one (mvog::Scan::origin).
+  Eigen::Isometry3d pose = map_from_sensor;
+  pose.translation().z() = static_cast<double>(static_cast<float>(pose.translation().z()));
   mvog::Scan readings;
-  readings.origin = map_from_sensor.translation();
+  readings.origin = pose.translation();
   readings.hits.reserve(scan.ranges.size());
   skipped_beams = 0;
   for (std::size_t k = 0; k < scan.ranges.size(); ++k) {
@@ -60,9 +64,9 @@ mvog::Scan laserScanToScan(const sensor_msgs::LaserScan& scan,
     const double angle = scan.angle_min + static_cast<double>(k) * scan.angle_increment;
     const Eigen::Vector3d direction(std::cos(angle), std::sin(angle), 0.0);
     if (std::isfinite(range) && range >= scan.range_min && range <= scan.range_max) {
-      readings.hits.push_back((map_from_sensor * (range * direction)).cast<float>());
+      readings.hits.push_back((pose * (range * direction)).cast<float>());
     } else if (range == std::numeric_limits<double>::infinity() || range > scan.range_max) {
-      readings.out_of_range.push_back((map_from_sensor * (free_range * direction)).cast<float>());
+      readings.out_of_range.push_back((pose * (free_range * direction)).cast<float>());
     } else {
       ++skipped_beams;
     }

@@ -108,6 +108,23 @@ TEST(LaserScanToScan, AppliesTheSensorPoseAndStartsRaysAtTheSensor) {
   expectNear(readings.out_of_range[0], {11.0, 2.0, 3.0});  // sensor -y = map x
 }
 
+TEST(LaserScanToScan, ALevelLasersReadingsLieAtItsHeightExactly) {
+  // A level laser 0.3 m up (not a float), turned about z: every reading at the origin's height,
+  // bit for bit (the map then inserts the scan as a level one), within a float's step of 0.3 m.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translate(Eigen::Vector3d(1.25, -2.0, 0.3));
+  pose.rotate(Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ())));
+  std::size_t skipped = 0;
+  const mvog::Scan readings =
+      laserScanToScan(fourBeamScan({1.3f, 2.7f, 9.9f, kInf}), pose, kInf, kManyPoints, skipped);
+  EXPECT_NEAR(readings.origin.z(), 0.3, 1e-7);
+  EXPECT_EQ(readings.origin.x(), 1.25);
+  ASSERT_EQ(readings.hits.size(), 3u);
+  ASSERT_EQ(readings.out_of_range.size(), 1u);
+  for (const Eigen::Vector3f& hit : readings.hits) EXPECT_EQ(hit.z(), readings.origin.z());
+  EXPECT_EQ(readings.out_of_range[0].z(), readings.origin.z());
+}
+
 TEST(LaserScanToScan, AcceptsOneBeamWithoutIncrement) {
   sensor_msgs::LaserScan scan = fourBeamScan({2.0f});
   scan.angle_increment = 0.0f;
