@@ -110,8 +110,10 @@ class ScanScratch {
   void begin(float join_gap, bool count_masses, const CellRange& tiles,
              const Volume* level = nullptr);
 
-  /// Adds one scan's volumes to the scratch; kept by one ray walk, so that what every cell
-  /// visit needs stays in registers. kLevel: the writer of a level scan (see begin).
+  /// Adds one scan's volumes to the scratch at the cell where it is: the cursor of a ray's walk
+  /// (walkRayWith), copied into each walk so that what every cell visit needs stays in
+  /// registers. It keeps the cell as its tile and the cell's place there, moved one step at a
+  /// time. kLevel: the writer of a level scan (see begin).
   template <bool kCountMasses, bool kLevel = false>
   class Writer {
    public:
@@ -120,11 +122,36 @@ class ScanScratch {
           stamp_(scratch.stamp_),
           inline_only_(slotTag(scratch.stamp_, kNoOthers)),
           join_gap_(scratch.join_gap_) {}
+
+    void moveTo(const CellIndex& cell) {
+      tile_x_ = cell.x >> kTileSizeLog2;
+      tile_y_ = cell.y >> kTileSizeLog2;
+      local_x_ = cell.x & (kTileSize - 1);
+      local_y_ = cell.y & (kTileSize - 1);
+      tile_ = nullptr;
+    }
+    void stepX(int step) {
+      local_x_ += step;
+      if (static_cast<unsigned>(local_x_) >= kTileSize) {  // into the next tile along x
+        local_x_ -= step * kTileSize;
+        tile_x_ += step;
+        tile_ = nullptr;
+      }
+    }
+    void stepY(int step) {
+      local_y_ += step;
+      if (static_cast<unsigned>(local_y_) >= kTileSize) {
+        local_y_ -= step * kTileSize;
+        tile_y_ += step;
+        tile_ = nullptr;
+      }
+    }
+
     /// Called for every cell a ray crosses: the commonest case (the interval inline grows and
     /// reaches no other) stays inline in the ray walk.
-    void addFree(const CellIndex& cell, const Volume& volume) {
-      ScratchTile& tile = tileFor(cell);
-      const unsigned local = localIndex(cell);
+    void addFree(const Volume& volume) {
+      ScratchTile& tile = currentTile();
+      const unsigned local = currentLocal();
       if constexpr (kLevel) {  // every free volume of the scan is the level one
         static_assert(!kCountMasses, "a level scan's cells hold no masses");
         tile.markLevelFree(local);
@@ -145,32 +172,29 @@ class ScanScratch {
       }
       scratch_.addFreeSlow(tile, local, volume);
     }
-    void addHit(const CellIndex& cell, const Volume& volume) {
-      scratch_.addHit(tileFor(cell), localIndex(cell), volume);
-    }
+    void addHit(const Volume& volume) { scratch_.addHit(currentTile(), currentLocal(), volume); }
 
    private:
-    ScratchTile& tileFor(const CellIndex& cell) {
-      const std::int32_t tx = cell.x >> kTileSizeLog2;
-      const std::int32_t ty = cell.y >> kTileSizeLog2;
-      // Consecutive cells of a ray mostly share a tile.
-      if (tx != x_ || ty != y_) {
-        ScratchTile* known = scratch_.denseTile(tx, ty);
-        tile_ = known != nullptr ? known : &scratch_.findOrAddTile(tx, ty);
-        x_ = tx;
-        y_ = ty;
+    /// The cell's tile, found when the walk first visits a cell of it (a tile whose cells the
+    /// walk only touches at a corner is not added).
+    ScratchTile& currentTile() {
+      if (tile_ == nullptr) {
+        ScratchTile* known = scratch_.denseTile(tile_x_, tile_y_);
+        tile_ = known != nullptr ? known : &scratch_.findOrAddTile(tile_x_, tile_y_);
       }
       return *tile_;
     }
+    unsigned currentLocal() const { return static_cast<unsigned>(local_y_ * kTileSize + local_x_); }
 
     ScanScratch& scratch_;
     const std::uint32_t stamp_;
     const std::uint64_t inline_only_;  ///< the tag of a slot of this scan without others
     const float join_gap_;
     ScratchTile* tile_ = nullptr;
-    // No tile yet: no cell within MapConfig's bounds (2^22 cells) is in tile x = INT32_MIN.
-    std::int32_t x_ = std::numeric_limits<std::int32_t>::min();
-    std::int32_t y_ = 0;
+    std::int32_t tile_x_ = 0;
+    std::int32_t tile_y_ = 0;
+    std::int32_t local_x_ = 0;  ///< 0 to kTileSize - 1 between steps
+    std::int32_t local_y_ = 0;
   };
 
   /// The tile `key` of this scan, or nullptr.

@@ -231,19 +231,19 @@ template <class Writer, class FreeVolume>
 void walkReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
                  Writer& scratch, const FreeVolume& free_volume) {
   const auto end_z = static_cast<float>(end.z());
-  walkRay(start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
-          [&](const CellIndex& cell, double z_enter, double z_exit, bool is_last) {
-            if (!is_last || !obstacle) {  // eqs. (3) and (4)
-              scratch.addFree(cell, free_volume(z_enter, z_exit));
-              return;
-            }
-            const Volume positive = makeVolume(end_z - 0.5f, end_z + 0.5f);  // eq. (5)
-            scratch.addHit(cell, positive);
-            if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
-              scratch.addFree(cell, makeVolume(static_cast<float>(z_enter),
-                                               z_enter < end.z() ? positive.bottom : positive.top));
-            }
-          });
+  walkRayWith(scratch, start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
+              [&](double z_enter, double z_exit, bool is_last) {
+                if (!is_last || !obstacle) {  // eqs. (3) and (4)
+                  scratch.addFree(free_volume(z_enter, z_exit));
+                  return;
+                }
+                const Volume positive = makeVolume(end_z - 0.5f, end_z + 0.5f);  // eq. (5)
+                scratch.addHit(positive);
+                if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
+                  scratch.addFree(makeVolume(static_cast<float>(z_enter),
+                                             z_enter < end.z() ? positive.bottom : positive.top));
+                }
+              });
 }
 
 /// The volumes of one reading (see walkReading), into `scratch` (a copy of the chunk's writer,
@@ -254,7 +254,10 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
   const auto end_z = static_cast<float>(end.z());
   if (!model_negative_space) {
     // Only the obstacle's own volume, in the cell the walk would end in (see walkRay): no walk.
-    if (obstacle) scratch.addHit(cellAt(end.x(), end.y()), makeVolume(end_z - 0.5f, end_z + 0.5f));
+    if (obstacle) {
+      scratch.moveTo(cellAt(end.x(), end.y()));
+      scratch.addHit(makeVolume(end_z - 0.5f, end_z + 0.5f));
+    }
     return;
   }
   if (start.z() == end.z()) {
