@@ -260,10 +260,6 @@ class ScanScratch {
   Volume level_volume_{};
 };
 
-/// Joins [bottom, top] into the sorted `list` of intervals more than `join_gap` apart; returns
-/// the index of the interval that holds it.
-std::size_t joinInterval(std::vector<ScanInterval>& list, float bottom, float top, double mass,
-                         float join_gap);
 /// Joins the intervals of a list sorted by bottom that come within `join_gap`, in place.
 void joinSorted(std::vector<ScanInterval>& intervals, float join_gap);
 /// Which thread's scratch each reading of a scan goes to, and what decided it: kept from scan

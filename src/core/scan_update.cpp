@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 #include "mvog/raster.h"
@@ -12,27 +13,6 @@
 
 namespace mvog {
 namespace detail {
-
-std::size_t joinInterval(std::vector<ScanInterval>& list, float bottom, float top, double mass,
-                         float join_gap) {
-  // Columns hold a few intervals: a linear scan to the first that is not wholly below.
-  auto first = list.begin();
-  while (first != list.end() && !joins(first->top, bottom, join_gap)) ++first;
-  const auto index = static_cast<std::size_t>(first - list.begin());
-  if (first == list.end() || !joins(top, first->bottom, join_gap)) {
-    list.insert(first, {bottom, top, mass});
-    return index;
-  }
-  ScanInterval joined{std::min(bottom, first->bottom), top, mass};
-  auto last = first;
-  for (; last != list.end() && joins(joined.top, last->bottom, join_gap); ++last) {
-    joined.top = std::max(joined.top, last->top);
-    joined.mass += last->mass;
-  }
-  *first = joined;
-  list.erase(first + 1, last);
-  return index;
-}
 
 void joinSorted(std::vector<ScanInterval>& intervals, float join_gap) {
   std::size_t out = 0;
@@ -107,20 +87,40 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
     if (count_masses_) tile.masses[local] += mass;
     return;
   }
-  // Join the volume into all of the cell's intervals, then keep the one it reached inline.
+  // The volume joins the inline interval if it reaches it, and the run of other intervals it
+  // reaches (a column's intervals lie more than join_gap apart: what the volume reaches is one
+  // run, and their union reaches nothing more, nor the inline interval if the volume does not).
+  // The union goes inline; an inline interval it did not take goes among the others.
   OtherIntervals& others = others_[slot.others()];
   std::vector<ScanInterval>& list = others.intervals;
   const ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
-  list.insert(std::partition_point(list.begin(), list.end(),
-                                   [&](const ScanInterval& i) { return i.top < current.bottom; }),
-              current);
-  const std::size_t k = joinInterval(list, volume.bottom, volume.top, mass, join_gap_);
-  slot.bottom = list[k].bottom;
-  slot.top = list[k].top;
-  tile.masses[local] = list[k].mass;
-  list.erase(list.begin() + static_cast<std::ptrdiff_t>(k));
-  others.below = k > 0 ? list[k - 1].top : -kInfinity;
-  others.above = k < list.size() ? list[k].bottom : kInfinity;
+  ScanInterval joined{volume.bottom, volume.top, mass};
+  const bool joins_current =
+      intervalsJoin(volume.bottom, volume.top, current.bottom, current.top, join_gap_);
+  if (joins_current) {
+    joined = {std::min(joined.bottom, current.bottom), std::max(joined.top, current.top),
+              joined.mass + current.mass};
+  }
+  auto first = list.begin();
+  while (first != list.end() && !joins(first->top, joined.bottom, join_gap_)) ++first;
+  auto last = first;
+  for (; last != list.end() && joins(joined.top, last->bottom, join_gap_); ++last) {
+    joined.bottom = std::min(joined.bottom, last->bottom);
+    joined.top = std::max(joined.top, last->top);
+    joined.mass += last->mass;
+  }
+  list.erase(first, last);
+  auto below_of = [&list](float bottom) {  // the first interval not wholly below `bottom`
+    return std::partition_point(list.begin(), list.end(),
+                                [bottom](const ScanInterval& i) { return i.top < bottom; });
+  };
+  if (!joins_current) list.insert(below_of(current.bottom), current);
+  slot.bottom = joined.bottom;
+  slot.top = joined.top;
+  tile.masses[local] = joined.mass;
+  const auto next = below_of(joined.bottom);
+  others.below = next == list.begin() ? -kInfinity : std::prev(next)->top;
+  others.above = next == list.end() ? kInfinity : next->bottom;
 }
 
 void ScanScratch::addHit(ScratchTile& tile, unsigned local, const Volume& volume) {
