@@ -26,7 +26,8 @@ enum class ReadingKind : std::uint8_t {
 /// One scan (or point cloud) taken from one origin, in the map frame, metres.
 struct Scan {
   /// The sensor's position. A level laser's scan, every reading at this height exactly (a height
-  /// a float holds), is inserted with one free volume for all the cells it crosses: fastest.
+  /// a float holds), is inserted with one free volume for all the cells it crosses when masses
+  /// count per scan (MassCounting::kPerScan, the default): fastest.
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   /// Obstacle readings: the points where a ray hit something.
   std::vector<Eigen::Vector3f> hits;

@@ -815,32 +815,37 @@ TEST(Insertion, LevelAndShallowRaysEqualThePlainReference) {
 
 TEST(Insertion, ThreadsBuildTheSameMapFromLevelScans) {
   // A level scan's threads keep one bit a cell for its one free volume (its readings at its
-  // origin's height, in float as in double: 0.375 m). A scan with a few rising
-  // rays in one direction has a thread whose readings are not all level beside threads whose
-  // are, their parts joined in the columns near the origin that both reach. With 2 to 4 threads:
-  // the same volumes, bit for bit, as test::ReferenceModel's with one.
-  for (const ModelRules& rules : {ModelRules::paper(), ModelRules{}}) {
-    SCOPED_TRACE(describe(rules));
-    std::vector<Scan> scans;
-    std::mt19937 rng(12);
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2d origin(std::uniform_real_distribution<double>(-1.0, 1.0)(rng),
-                                   std::uniform_real_distribution<double>(-1.0, 1.0)(rng));
-      scans.push_back(planarLaserScan(rng, origin, 0.375, 240, 0.0));
-    }
-    for (int k = 0; k < 6; ++k) {  // rising rays within 0.1 rad of +x, in the second scan
-      const Eigen::Vector3d ray(2.0 + 0.5 * k, 0.04 * k, 0.1 + 0.25 * k);
-      scans[1].hits.push_back((scans[1].origin + ray).cast<float>());
-    }
-    test::MapBesideReference reference(MapConfig{0.05, 60000.0, rules});
-    for (const Scan& scan : scans) ASSERT_TRUE(reference.insert(scan));
-    for (int threads = 2; threads <= 4; ++threads) {
-      Map map(MapConfig{0.05, 60000.0, rules});
-      InsertionConfig config;
-      config.insertion_threads = threads;
-      for (const Scan& scan : scans) map.insertScan(scan, config);
-      EXPECT_TRUE(test::sameVolumes(allVolumes(map), allVolumes(reference.map)))
-          << threads << " threads";
+  // origin's height, in float as in double: 0.375 m). A scan with a few rising rays in one
+  // direction has a thread whose readings are not all level beside threads whose are, their parts
+  // joined in the columns near the origin that both reach. Hits within and beyond max_range, and
+  // readings without a return freed up to out_of_range_free_length (both truncate level rays).
+  // With 1 to 4 threads: the same volumes, bit for bit, as test::ReferenceModel's.
+  InsertionConfig truncating;
+  truncating.max_range = 2.5;
+  for (const InsertionConfig& insertion : {InsertionConfig{}, truncating}) {
+    for (const ModelRules& rules : {ModelRules::paper(), ModelRules{}}) {
+      SCOPED_TRACE(describe(rules) + ", max_range " + std::to_string(insertion.max_range));
+      std::vector<Scan> scans;
+      std::mt19937 rng(12);
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d origin(std::uniform_real_distribution<double>(-1.0, 1.0)(rng),
+                                     std::uniform_real_distribution<double>(-1.0, 1.0)(rng));
+        scans.push_back(planarLaserScan(rng, origin, 0.375, 240, 0.0));
+      }
+      for (int k = 0; k < 6; ++k) {  // rising rays within 0.1 rad of +x, in the second scan
+        const Eigen::Vector3d ray(2.0 + 0.5 * k, 0.04 * k, 0.1 + 0.25 * k);
+        scans[1].hits.push_back((scans[1].origin + ray).cast<float>());
+      }
+      const MapConfig map_config{0.05, 60000.0, rules};
+      test::ReferenceModel reference(map_config);
+      for (const Scan& scan : scans) reference.insertScan(scan, insertion);
+      for (int threads = 1; threads <= 4; ++threads) {
+        Map map(map_config);
+        InsertionConfig config = insertion;
+        config.insertion_threads = threads;
+        for (const Scan& scan : scans) map.insertScan(scan, config);
+        EXPECT_TRUE(test::sameAsReference(map, reference)) << threads << " threads";
+      }
     }
   }
 }
