@@ -203,8 +203,9 @@ class ScanScratch {
   /// Whether cell `local` of `tile` holds exactly one free interval; if so, sets it.
   bool singleFree(const ScratchTile& tile, unsigned local, ScanInterval& interval) const {
     if (level_) {
+      if (!tile.levelFree(local)) return false;
       interval = {level_volume_.bottom, level_volume_.top, 0.0};
-      return tile.levelFree(local);
+      return true;
     }
     const FreeSlot& slot = tile.slots[local];
     if (slot.tag != slotTag(stamp_, kNoOthers)) return false;

@@ -225,6 +225,10 @@ bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, Re
 /// heights half a cell apart stay less than a cell apart as floats.
 constexpr double kShallowRayMaxHeight = 1 << 20;
 
+/// Eq. (6) for a level ray at `height` (grid units): it enters and leaves every cell at that
+/// height, so every cell it crosses gets this one free volume.
+Volume levelRayVolume(float height) { return makeVolume(height, height); }
+
 /// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`,
 /// each cell's free volume from `free_volume(z_enter, z_exit)`.
 template <class Writer, class FreeVolume>
@@ -261,9 +265,8 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
     return;
   }
   if (start.z() == end.z()) {
-    // A level ray (a 2D laser's): it enters and leaves every cell at its one height, so eq. (6)
-    // gives every cell the same free volume, made once instead of in each cell.
-    const Volume level = makeVolume(end_z, end_z);
+    // A level ray (a 2D laser's): its one free volume made once instead of in each cell.
+    const Volume level = levelRayVolume(end_z);
     walkReading(start, end, obstacle, scratch, [&](double, double) { return level; });
     return;
   }
@@ -467,9 +470,7 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
       tiles = {tile_of(low), tile_of(high)};
     }
     const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
-    const auto level_height = static_cast<float>(scan.origin.z() * s);
-    const Volume level_volume = makeVolume(level_height, level_height);
-    level = level && !count_masses && insertion.model_negative_space;
+    const Volume level_volume = detail::levelRayVolume(static_cast<float>(scan.origin.z() * s));
     scratch.begin(detail::joinGapOf(map_config.rules), count_masses, tiles,
                   level ? &level_volume : nullptr);
     if (count_masses) {
