@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -59,7 +58,8 @@ constexpr const char* kUsage =
     "  R           cell size in metres, repeatable (default 0.1)\n"
     "  M           hits further than M metres insert free space only, truncated (default: none)\n"
     "  N           MVOG insertion threads (default 1; OctoMap always uses one)\n"
-    "  K           each backend inserts K times and the fastest run is reported (default 1)\n"
+    "  K           each backend inserts K times, the backends taking turns, and the fastest\n"
+    "              run of each is reported (default 1)\n"
     "  --backend   repeatable: mvog, octomap, walk (the bare ray walk, MVOG's floor), both\n"
     "              (mvog and octomap, the default) or all\n"
     "  FRAME       the bag's world frame (default map)\n"
@@ -170,16 +170,11 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// The fastest of `repeat` runs of `run` (a shared machine only ever slows a run down); every
-/// run builds the same map, so the one kept stands for all.
+/// Keeps in `fastest` the faster of it and `next` (a shared machine only ever slows a run down);
+/// every run builds the same map, so the one kept stands for all.
 template <class Run, class SecondsOf>
-Run fastestOf(int repeat, const std::function<Run()>& run, SecondsOf seconds_of) {
-  Run fastest = run();
-  for (int k = 1; k < repeat; ++k) {
-    Run next = run();
-    if (seconds_of(next) < seconds_of(fastest)) fastest = std::move(next);
-  }
-  return fastest;
+void keepFaster(std::optional<Run>& fastest, Run next, SecondsOf seconds_of) {
+  if (!fastest || seconds_of(next) < seconds_of(*fastest)) fastest = std::move(next);
 }
 
 mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
@@ -198,25 +193,33 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
   std::optional<mvog_bench::MvogRun> mvog;
   std::optional<mvog_bench::OctomapRun> octomap;
-  if (arguments.run_mvog) {
-    mvog = fastestOf<mvog_bench::MvogRun>(
-        arguments.repeat, [&] { return mvog_bench::runMvog(input, options); },
-        [](const mvog_bench::MvogRun& r) { return r.stats.insert_seconds; });
+  // The backends take turns, one insertion each a round, so that a slow spell of a shared
+  // machine falls on all of them alike rather than on the repeats of one: the ratios of their
+  // fastest insertions are then measured over the same time.
+  for (int round = 0; round < arguments.repeat; ++round) {
+    if (arguments.run_mvog) {
+      keepFaster(mvog, mvog_bench::runMvog(input, options),
+                 [](const mvog_bench::MvogRun& r) { return r.stats.insert_seconds; });
+    }
+    if (arguments.run_octomap) {
+      keepFaster(octomap, mvog_bench::runOctomap(input, options),
+                 [](const mvog_bench::OctomapRun& r) { return r.stats.insert_seconds; });
+    }
+    if (arguments.run_walk) {
+      keepFaster(report.walk, mvog_bench::runWalk(input, options),
+                 [](const mvog_bench::WalkStats& r) { return r.insert_seconds; });
+    }
+  }
+  if (mvog) {
     report.mvog = mvog->stats;
     std::fprintf(stderr, "mvog_bench: %.3f m: mvog inserted in %.3f s\n", resolution,
                  mvog->stats.insert_seconds);
   }
-  if (arguments.run_octomap) {
-    octomap = fastestOf<mvog_bench::OctomapRun>(
-        arguments.repeat, [&] { return mvog_bench::runOctomap(input, options); },
-        [](const mvog_bench::OctomapRun& r) { return r.stats.insert_seconds; });
+  if (octomap) {
     std::fprintf(stderr, "mvog_bench: %.3f m: octomap inserted in %.3f s\n", resolution,
                  octomap->stats.insert_seconds);
   }
-  if (arguments.run_walk) {
-    report.walk = fastestOf<mvog_bench::WalkStats>(
-        arguments.repeat, [&] { return mvog_bench::runWalk(input, options); },
-        [](const mvog_bench::WalkStats& r) { return r.insert_seconds; });
+  if (report.walk) {
     std::fprintf(stderr, "mvog_bench: %.3f m: the bare walk took %.3f s\n", resolution,
                  report.walk->insert_seconds);
   }
