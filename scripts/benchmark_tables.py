@@ -113,6 +113,35 @@ def main(out):
                  "Table I: MVOG", "Table I: OctoMap", "MVOG file", "OctoMap .ot file"], memory))
     print("\n### Threads (0.05 m)\n")
     print(table(["file", "1 thread (s)", "2 threads (s)", "speed-up", "same map"], threads))
+    synthetic_rows = []
+    for path in sorted(glob.glob(f"{out}/synthetic_*.json")):
+        run = load(path)
+        mvog_quality = by_resolution(run["quality"], "mvog")
+        octomap_quality = by_resolution(run["quality"], "octomap")
+        results = {b: by_resolution(run["results"], b) for b in ("mvog", "octomap", "walk")}
+        comparison = by_resolution(run["comparison"])
+        for resolution in sorted(mvog_quality, reverse=True):
+            m, o = mvog_quality[resolution], octomap_quality[resolution]
+            synthetic_rows.append([
+                file_name(path, "synthetic_"), f"{resolution:g}",
+                f"{results['mvog'][resolution]['readings']:,}",
+                f"{percent(m['endpoints_occupied_percent'])} / "
+                f"{percent(o['endpoints_occupied_percent'])}",
+                f"{percent(m['along_rays_free_percent'])} / "
+                f"{percent(o['along_rays_free_percent'])}",
+                f"{percent(m['far_unknown_percent'])} / {percent(o['far_unknown_percent'])}",
+                f"{comparison[resolution]['readings_per_second_ratio']:.1f}x",
+                f"{results['walk'][resolution]['mvog_time_ratio']:.2f}x",
+                f"{comparison[resolution]['memory_ratio']:.3f}x",
+            ])
+    if synthetic_rows:
+        print("\n### Sensors none of the recordings has (mvog_bench --input synthetic:NAME, "
+              "one insertion)\n")
+        print(table(["sensor", "res (m)", "readings", "ends occupied: MVOG / OctoMap",
+                     "along free: MVOG / OctoMap", "far unknown: MVOG / OctoMap",
+                     "MVOG / OctoMap speed", "MVOG / walk time", "MVOG / OctoMap memory"],
+                    synthetic_rows))
+
     def quality_at(run, resolution=0.05):
         q = by_resolution(run["quality"], "mvog").get(resolution)
         return (f"{percent(q['endpoints_occupied_percent'])} / "

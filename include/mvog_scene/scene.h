@@ -36,6 +36,14 @@ struct Scene {
 std::vector<Box> roomWalls(const Eigen::Vector3d& min, const Eigen::Vector3d& max,
                            double thickness);
 
+/// A street 110 m long along x: the ground, blocks of buildings 6-15 m high on both sides with
+/// gaps between them, parked cars, poles and trees (a trunk and a round crown).
+Scene streetScene();
+
+/// An office 12 m x 8 m x 3 m (walls, floor and ceiling) with a desk, a cabinet, a pillar, boxes
+/// and a ball.
+Scene officeScene();
+
 /// A depth camera, by default the paper's SwissRanger 4000 (176 x 144 pixels).
 struct DepthCamera {
   int width = 176;
@@ -49,5 +57,34 @@ struct DepthCamera {
 /// out-of-range reading at `max_range`.
 mvog::Scan depthScan(const Scene& scene, const DepthCamera& camera, const Eigen::Vector3d& position,
                      double yaw, double tilt, double max_range);
+
+/// A rotating multi-beam lidar (an automotive one), by default a Velodyne VLP-16: `beams`
+/// elevations spread evenly over [min, max], each read every `azimuth_step_degrees` of a turn.
+struct RotatingLidar {
+  int beams = 16;
+  double min_elevation_degrees = -15.0;
+  double max_elevation_degrees = 15.0;
+  double azimuth_step_degrees = 0.2;
+};
+
+/// One turn of `lidar` at `position`: a hit where a beam meets a surface within `max_range`,
+/// else an out-of-range reading at `max_range`.
+mvog::Scan lidarScan(const Scene& scene, const RotatingLidar& lidar,
+                     const Eigen::Vector3d& position, double max_range);
+
+/// A 2D laser nodding about its horizontal axis (a tilting laser, as on Kurt3D or a MAV):
+/// `beams` over `field_of_view_degrees` about its heading, one sweep at each pitch from min to
+/// max (up is positive) every `pitch_step_degrees`.
+struct TiltingLaser {
+  int beams = 181;
+  double field_of_view_degrees = 180.0;
+  double min_pitch_degrees = -45.0;
+  double max_pitch_degrees = 45.0;
+  double pitch_step_degrees = 1.0;
+};
+
+/// One nod of `laser` at `position`, heading `yaw` about z (readings as lidarScan's).
+mvog::Scan tiltingLaserScan(const Scene& scene, const TiltingLaser& laser,
+                            const Eigen::Vector3d& position, double yaw, double max_range);
 
 }  // namespace mvog_scene

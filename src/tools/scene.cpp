@@ -53,6 +53,103 @@ std::vector<Box> roomWalls(const Eigen::Vector3d& min, const Eigen::Vector3d& ma
   return walls;
 }
 
+Scene streetScene() {
+  Scene street;
+  street.boxes.push_back({{-60, -60, -0.1}, {90, 60, 0}});  // the ground
+  for (int block = -5; block < 9; ++block) {                // 6.5 m and 5.5 m wide, 1.5-2.5 m apart
+    const double x = 8.0 * block;
+    const double height = 6.0 + 3.0 * ((block + 5) % 4);  // 6, 9, 12 or 15 m
+    street.boxes.push_back({{x, 9, 0}, {x + 6.5, 13, height}});
+    street.boxes.push_back({{x + 2, -13, 0}, {x + 7.5, -9, height + 2.0}});
+  }
+  for (int k = -3; k < 7; ++k) {
+    const double x = 6.0 * k;
+    street.boxes.push_back({{x, 4.5, 0}, {x + 4.2, 6.3, 1.5}});  // parked cars
+    street.boxes.push_back({{x + 3, -6.3, 0}, {x + 7.2, -4.5, 1.5}});
+    street.boxes.push_back({{x + 1, 7.5, 0}, {x + 1.2, 7.7, 5}});      // a pole
+    street.boxes.push_back({{x + 3.9, -7.6, 0}, {x + 4.1, -7.4, 3}});  // a tree
+    street.spheres.push_back({{x + 4, -7.5, 4.5}, 1.6});
+  }
+  return street;
+}
+
+Scene officeScene() {
+  Scene office;
+  office.boxes = roomWalls({-6, -4, 0}, {6, 4, 3}, 0.1);
+  office.boxes.push_back({{1.0, 1.5, 0.72}, {3.0, 2.5, 0.75}});  // desk top and legs
+  office.boxes.push_back({{1.0, 1.5, 0}, {1.05, 1.55, 0.72}});
+  office.boxes.push_back({{2.95, 2.45, 0}, {3.0, 2.5, 0.72}});
+  office.boxes.push_back({{-3.0, -2.5, 0}, {-1.5, -1.8, 0.8}});  // cabinet
+  office.boxes.push_back({{-0.2, -0.2, 0}, {0.2, 0.2, 3}});      // pillar
+  office.boxes.push_back({{2.0, -2.0, 0}, {2.4, -1.6, 0.4}});    // boxes
+  office.spheres.push_back({{-2, 2, 1.2}, 0.5});                 // a ball
+  return office;
+}
+
+namespace {
+
+/// The reading of the ray from `position` along the unit vector `direction`: a hit on the
+/// nearest surface within `max_range`, else an out-of-range reading at `max_range`.
+void castReading(const Scene& scene, const Eigen::Vector3d& position,
+                 const Eigen::Vector3d& direction, double max_range, mvog::Scan& scan) {
+  const double range = scene.castRay(position, direction);
+  if (range <= max_range) {
+    scan.hits.push_back((position + range * direction).cast<float>());
+  } else {
+    scan.out_of_range.push_back((position + max_range * direction).cast<float>());
+  }
+}
+
+/// The unit vector at `azimuth` about z from +x and `elevation` above the xy-plane (rad).
+Eigen::Vector3d unitDirection(double azimuth, double elevation) {
+  return {std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+          std::sin(elevation)};
+}
+
+double radians(double degrees) { return degrees * M_PI / 180.0; }
+
+}  // namespace
+
+mvog::Scan lidarScan(const Scene& scene, const RotatingLidar& lidar,
+                     const Eigen::Vector3d& position, double max_range) {
+  mvog::Scan scan;
+  scan.origin = position;
+  const auto steps = static_cast<int>(std::lround(360.0 / lidar.azimuth_step_degrees));
+  for (int beam = 0; beam < lidar.beams; ++beam) {
+    const double elevation = lidar.beams == 1
+                                 ? lidar.min_elevation_degrees
+                                 : lidar.min_elevation_degrees +
+                                       (lidar.max_elevation_degrees - lidar.min_elevation_degrees) *
+                                           beam / (lidar.beams - 1);
+    for (int step = 0; step < steps; ++step) {
+      castReading(scene, position,
+                  unitDirection(radians(step * lidar.azimuth_step_degrees), radians(elevation)),
+                  max_range, scan);
+    }
+  }
+  return scan;
+}
+
+mvog::Scan tiltingLaserScan(const Scene& scene, const TiltingLaser& laser,
+                            const Eigen::Vector3d& position, double yaw, double max_range) {
+  mvog::Scan scan;
+  scan.origin = position;
+  const auto sweeps =
+      static_cast<int>(std::lround((laser.max_pitch_degrees - laser.min_pitch_degrees) /
+                                   laser.pitch_step_degrees)) +
+      1;
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    const double pitch = laser.min_pitch_degrees + sweep * laser.pitch_step_degrees;
+    for (int beam = 0; beam < laser.beams; ++beam) {
+      const double across =
+          laser.beams == 1 ? 0.0 : laser.field_of_view_degrees * (beam / (laser.beams - 1.0) - 0.5);
+      castReading(scene, position, unitDirection(yaw + radians(across), radians(pitch)), max_range,
+                  scan);
+    }
+  }
+  return scan;
+}
+
 mvog::Scan depthScan(const Scene& scene, const DepthCamera& camera, const Eigen::Vector3d& position,
                      double yaw, double tilt, double max_range) {
   const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
@@ -66,13 +163,8 @@ mvog::Scan depthScan(const Scene& scene, const DepthCamera& camera, const Eigen:
     for (int u = 0; u < camera.width; ++u) {
       const double a = (2.0 * u / (camera.width - 1) - 1.0) * tan_x;
       const double b = (2.0 * v / (camera.height - 1) - 1.0) * tan_y;
-      const Eigen::Vector3d direction = (rotation * Eigen::Vector3d(1.0, -a, -b)).normalized();
-      const double range = scene.castRay(position, direction);
-      if (range <= max_range) {
-        scan.hits.push_back((position + range * direction).cast<float>());
-      } else {
-        scan.out_of_range.push_back((position + max_range * direction).cast<float>());
-      }
+      castReading(scene, position, (rotation * Eigen::Vector3d(1.0, -a, -b)).normalized(),
+                  max_range, scan);
     }
   }
   return scan;

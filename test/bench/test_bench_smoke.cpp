@@ -1,7 +1,7 @@
 // Smoke test of mvog_bench: behaviour only (never timings). Runs the executable on
 // spherical_scan.graph from the shared data (MVOG_DATA_DIR, default ../shared/data beside the
 // repository; skipped when absent unless CI=true), on scan graphs and a bag of depth images it
-// writes itself, and on bad input.
+// writes itself, on its synthetic sensors, and on bad input.
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -134,6 +134,42 @@ TEST_F(BenchSmokeTest, ReadsEveryNodeOfAGraphItWrote) {
   }
   EXPECT_EQ(root["input"]["scans"].asUInt64(), 2u);
   EXPECT_EQ(root["repeat"].asInt(), 2);
+}
+
+// Sensors none of the shared recordings has (a multi-beam automotive lidar, a tilting laser),
+// cast into scenes built in code: what each saw stays occupied as in OctoMap on the same rays,
+// within issue 10's margins (ends occupied >= OctoMap's - 2 points, along the rays free >=
+// OctoMap's - 1), and nothing is known far from the rays.
+TEST_F(BenchSmokeTest, SyntheticSensorsKeepWhatTheySawAsOctoMapDoes) {
+  for (const std::string& name : {std::string("rotating-lidar-16"), std::string("tilting-laser")}) {
+    SCOPED_TRACE(name);
+    const std::string json = directory_ + "/" + name + ".json";
+    std::string errors;
+    ASSERT_EQ(runBench("--input synthetic:" + name + " --resolution 0.1 --backend both --json '" +
+                           json + "'",
+                       errors),
+              0)
+        << errors;
+    const Json::Value root = readJson(json);
+    EXPECT_EQ(root["input"]["format"].asString(), "synthetic");
+    EXPECT_EQ(root["input"]["scans"].asUInt64(), 10u);
+    Json::Value mvog;
+    Json::Value octomap;
+    for (const Json::Value& quality : root["quality"]) {
+      (quality["backend"].asString() == "mvog" ? mvog : octomap) = quality;
+    }
+    ASSERT_FALSE(mvog.isNull());
+    ASSERT_FALSE(octomap.isNull());
+    EXPECT_GE(mvog["endpoints_occupied_percent"].asDouble(),
+              octomap["endpoints_occupied_percent"].asDouble() - 2.0);
+    EXPECT_GE(mvog["along_rays_free_percent"].asDouble(),
+              octomap["along_rays_free_percent"].asDouble() - 1.0);
+    EXPECT_GE(mvog["far_unknown_percent"].asDouble(), 99.0);
+  }
+  std::string errors;
+  EXPECT_EQ(runBench("--input synthetic:sonar", errors), 1);
+  EXPECT_NE(errors.find("no such synthetic input (there are rotating-lidar-16"), std::string::npos)
+      << errors;
 }
 
 /// A depth image of `width` x `height` pixels of `encoding` (Pixel: std::uint16_t for 16UC1,

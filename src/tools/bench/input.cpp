@@ -12,20 +12,24 @@ std::size_t InputData::readings() const {
 
 InputData loadInput(const std::string& path, const std::string& fixed_frame,
                     double depth_no_return_length) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError(path + ": cannot open the file (missing or unreadable)");
-  static const std::string kBagMagic = "#ROSBAG V2.0\n";
-  std::string head(kBagMagic.size(), '\0');
-  file.read(&head[0], static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(file.gcount()));
-  file.close();
   InputData input;
-  if (head == kBagMagic) {
-    input = loadBag(path, fixed_frame, depth_no_return_length);
-  } else if (path.size() >= 6 && path.compare(path.size() - 6, 6, ".graph") == 0) {
-    input = loadScanGraph(path);
+  if (path.compare(0, kSyntheticPrefix.size(), kSyntheticPrefix) == 0) {
+    input = loadSynthetic(path.substr(kSyntheticPrefix.size()));
   } else {
-    throw InputError(path + ": neither a ROS bag (format 2.0) nor an OctoMap ScanGraph (.graph)");
+    std::ifstream file(path, std::ios::binary);
+    if (!file) throw InputError(path + ": cannot open the file (missing or unreadable)");
+    static const std::string kBagMagic = "#ROSBAG V2.0\n";
+    std::string head(kBagMagic.size(), '\0');
+    file.read(&head[0], static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(file.gcount()));
+    file.close();
+    if (head == kBagMagic) {
+      input = loadBag(path, fixed_frame, depth_no_return_length);
+    } else if (path.size() >= 6 && path.compare(path.size() - 6, 6, ".graph") == 0) {
+      input = loadScanGraph(path);
+    } else {
+      throw InputError(path + ": neither a ROS bag (format 2.0) nor an OctoMap ScanGraph (.graph)");
+    }
   }
   if (input.readings() == 0) {
     throw InputError(path + ": no obstacle readings to insert (" +

@@ -41,7 +41,11 @@ struct InputData {
   std::size_t readings() const;
 };
 
-/// Reads a ROS bag (by its "#ROSBAG V2.0" header) or an OctoMap ScanGraph (.graph).
+/// What names a synthetic input instead of a file: "synthetic:NAME" (loadSynthetic).
+inline const std::string kSyntheticPrefix = "synthetic:";
+
+/// Reads a ROS bag (by its "#ROSBAG V2.0" header) or an OctoMap ScanGraph (.graph), or makes the
+/// synthetic input "synthetic:NAME".
 /// `depth_no_return_length`: where the out-of-range readings of a bag's depth images end (m;
 /// infinite: their +Inf pixels are skipped). Throws InputError for a missing, unreadable,
 /// truncated or unusable file.
@@ -54,6 +58,15 @@ InputData loadInput(const std::string& path, const std::string& fixed_frame,
 /// other encodings (colour, mono) are not range data and are not read.
 InputData loadBag(const std::string& path, const std::string& fixed_frame,
                   double depth_no_return_length);
+
+/// The scans of a sensor that none of the shared recordings has, cast into a scene built in code
+/// (mvog_scene), by `name`: "rotating-lidar-16" (a Velodyne VLP-16, 16 beams from -15 to +15
+/// degrees, 0.2 degrees apart in azimuth) and "rotating-lidar-32" (an HDL-32E, 32 beams from
+/// -30.67 to +10.67 degrees), each 1.8 m up on 10 turns 2 m apart along a street (100 m range);
+/// "tilting-laser" (181 beams over 180 degrees, nodding from -45 to +45 degrees a degree at a
+/// time), 0.5 m up on 10 poses across an office (30 m range). Beams that meet nothing within
+/// range are out-of-range readings. Throws InputError for an unknown name.
+InputData loadSynthetic(const std::string& name);
 
 /// Every node of an OctoMap ScanGraph binary file, parsed with every count checked against the
 /// file size first (a truncated or corrupt file is an error, never a partial graph).
