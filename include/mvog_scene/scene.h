@@ -7,7 +7,8 @@
 #include "mvog/map.h"
 
 /// Synthetic scenes for the tools and the tests (mvog_synthetic_demo, mvog_microbench,
-/// test_mapper_node): obstacles to cast rays into, and a depth camera that sees them. ROS-free.
+/// mvog_bench's synthetic inputs, test_mapper_node): obstacles to cast rays into, and the
+/// sensors that see them (a depth camera, a rotating lidar, a tilting laser). ROS-free.
 namespace mvog_scene {
 
 /// An axis-aligned box (m). Infinite bounds make a slab or a column of infinite height.
@@ -36,8 +37,9 @@ struct Scene {
 std::vector<Box> roomWalls(const Eigen::Vector3d& min, const Eigen::Vector3d& max,
                            double thickness);
 
-/// A street 110 m long along x: the ground, blocks of buildings 6-15 m high on both sides with
-/// gaps between them, parked cars, poles and trees (a trunk and a round crown).
+/// A street with 110 m of buildings along x: the ground (150 m x 120 m), blocks of buildings
+/// 6-17 m high on both sides with gaps between them, parked cars, poles and trees (a trunk and a
+/// round crown).
 Scene streetScene();
 
 /// An office 12 m x 8 m x 3 m (walls, floor and ceiling) with a desk, a cabinet, a pillar, boxes
@@ -72,9 +74,9 @@ struct RotatingLidar {
 mvog::Scan lidarScan(const Scene& scene, const RotatingLidar& lidar,
                      const Eigen::Vector3d& position, double max_range);
 
-/// A 2D laser nodding about its horizontal axis (a tilting laser, as on Kurt3D or a MAV):
-/// `beams` over `field_of_view_degrees` about its heading, one sweep at each pitch from min to
-/// max (up is positive) every `pitch_step_degrees`.
+/// A 2D laser nodding about its horizontal axis across its heading (a tilting laser, as on
+/// Kurt3D or a MAV): `beams` over `field_of_view_degrees` in its scan plane, one sweep with the
+/// plane pitched from min to max (up is positive) every `pitch_step_degrees`.
 struct TiltingLaser {
   int beams = 181;
   double field_of_view_degrees = 180.0;

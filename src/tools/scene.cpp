@@ -58,7 +58,7 @@ Scene streetScene() {
   street.boxes.push_back({{-60, -60, -0.1}, {90, 60, 0}});  // the ground
   for (int block = -5; block < 9; ++block) {                // 6.5 m and 5.5 m wide, 1.5-2.5 m apart
     const double x = 8.0 * block;
-    const double height = 6.0 + 3.0 * ((block + 5) % 4);  // 6, 9, 12 or 15 m
+    const double height = 6.0 + 3.0 * ((block + 5) % 4);  // 6, 9, 12 or 15 m, 2 m more across
     street.boxes.push_back({{x, 9, 0}, {x + 6.5, 13, height}});
     street.boxes.push_back({{x + 2, -13, 0}, {x + 7.5, -9, height + 2.0}});
   }
@@ -76,7 +76,7 @@ Scene streetScene() {
 Scene officeScene() {
   Scene office;
   office.boxes = roomWalls({-6, -4, 0}, {6, 4, 3}, 0.1);
-  office.boxes.push_back({{1.0, 1.5, 0.72}, {3.0, 2.5, 0.75}});  // desk top and legs
+  office.boxes.push_back({{1.0, 1.5, 0.72}, {3.0, 2.5, 0.75}});  // desk top and two legs
   office.boxes.push_back({{1.0, 1.5, 0}, {1.05, 1.55, 0.72}});
   office.boxes.push_back({{2.95, 2.45, 0}, {3.0, 2.5, 0.72}});
   office.boxes.push_back({{-3.0, -2.5, 0}, {-1.5, -1.8, 0.8}});  // cabinet
@@ -139,12 +139,18 @@ mvog::Scan tiltingLaserScan(const Scene& scene, const TiltingLaser& laser,
                                    laser.pitch_step_degrees)) +
       1;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
-    const double pitch = laser.min_pitch_degrees + sweep * laser.pitch_step_degrees;
+    // The scan plane turned about the laser's y axis (up by `pitch`), then about z by `yaw`: the
+    // beams across, at +-90 degrees, lie on the nodding axis and stay level.
+    const double pitch = radians(laser.min_pitch_degrees + sweep * laser.pitch_step_degrees);
+    const Eigen::Matrix3d plane = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                                   Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitY()))
+                                      .toRotationMatrix();
     for (int beam = 0; beam < laser.beams; ++beam) {
-      const double across =
-          laser.beams == 1 ? 0.0 : laser.field_of_view_degrees * (beam / (laser.beams - 1.0) - 0.5);
-      castReading(scene, position, unitDirection(yaw + radians(across), radians(pitch)), max_range,
-                  scan);
+      const double across = radians(laser.beams == 1 ? 0.0
+                                                     : laser.field_of_view_degrees *
+                                                           (beam / (laser.beams - 1.0) - 0.5));
+      castReading(scene, position, plane * Eigen::Vector3d(std::cos(across), std::sin(across), 0.0),
+                  max_range, scan);
     }
   }
   return scan;

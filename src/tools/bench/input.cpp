@@ -13,7 +13,7 @@ std::size_t InputData::readings() const {
 InputData loadInput(const std::string& path, const std::string& fixed_frame,
                     double depth_no_return_length) {
   InputData input;
-  if (path.compare(0, kSyntheticPrefix.size(), kSyntheticPrefix) == 0) {
+  if (std::string_view(path).substr(0, kSyntheticPrefix.size()) == kSyntheticPrefix) {
     input = loadSynthetic(path.substr(kSyntheticPrefix.size()));
   } else {
     std::ifstream file(path, std::ios::binary);

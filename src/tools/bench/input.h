@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "mvog/map.h"
@@ -23,11 +24,11 @@ class InputError : public std::runtime_error {
 /// are disregarded in all four representations"), so `Scan::out_of_range` is always empty;
 /// given to MVOG alone with mvog_bench --out-of-range-free-length.
 struct InputData {
-  std::string format;  ///< "bag" or "graph"
+  std::string format;  ///< "bag", "graph" or "synthetic"
   std::vector<mvog::Scan> scans;
   /// The out-of-range readings of each scan (at the sensor's range_max).
   std::vector<std::vector<Eigen::Vector3f>> out_of_range;
-  /// LaserScan, PointCloud2 and depth Image messages, or graph nodes
+  /// LaserScan, PointCloud2 and depth Image messages, graph nodes, or synthetic scans
   std::size_t sensor_messages = 0;
   std::size_t without_transform = 0;      ///< messages skipped: no transform to the fixed frame
   std::size_t without_camera_info = 0;    ///< depth images skipped: no camera info of their stamp
@@ -42,7 +43,7 @@ struct InputData {
 };
 
 /// What names a synthetic input instead of a file: "synthetic:NAME" (loadSynthetic).
-inline const std::string kSyntheticPrefix = "synthetic:";
+constexpr std::string_view kSyntheticPrefix = "synthetic:";
 
 /// Reads a ROS bag (by its "#ROSBAG V2.0" header) or an OctoMap ScanGraph (.graph), or makes the
 /// synthetic input "synthetic:NAME".

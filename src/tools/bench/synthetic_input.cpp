@@ -4,6 +4,9 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "input.h"
 #include "mvog_scene/scene.h"
@@ -14,9 +17,11 @@ namespace {
 /// A drive of `lidar` 1.8 m above the street: 10 turns 2 m apart along it, weaving a little.
 std::vector<mvog::Scan> streetDrive(const mvog_scene::RotatingLidar& lidar) {
   constexpr double kMaxRange = 100.0;
+  constexpr int kTurns = 10;
   const mvog_scene::Scene street = mvog_scene::streetScene();
   std::vector<mvog::Scan> scans;
-  for (int k = 0; k < 10; ++k) {
+  scans.reserve(kTurns);
+  for (int k = 0; k < kTurns; ++k) {
     scans.push_back(mvog_scene::lidarScan(
         street, lidar, Eigen::Vector3d(2.0 * k, 0.3 * std::sin(k), 1.8), kMaxRange));
   }
@@ -27,9 +32,11 @@ std::vector<mvog::Scan> streetDrive(const mvog_scene::RotatingLidar& lidar) {
 /// 0.3 rad further.
 std::vector<mvog::Scan> officeNods() {
   constexpr double kMaxRange = 30.0;
+  constexpr int kNods = 10;
   const mvog_scene::Scene office = mvog_scene::officeScene();
   std::vector<mvog::Scan> scans;
-  for (int k = 0; k < 10; ++k) {
+  scans.reserve(kNods);
+  for (int k = 0; k < kNods; ++k) {
     scans.push_back(mvog_scene::tiltingLaserScan(
         office, mvog_scene::TiltingLaser(), Eigen::Vector3d(-3.0 + 0.6 * k, 0.2 * k - 1.3, 0.5),
         0.3 * k, kMaxRange));
@@ -61,8 +68,8 @@ InputData loadSynthetic(const std::string& name) {
   if (sensor == sensors().end()) {
     std::string names;
     for (const auto& [known, scans] : sensors()) names += (names.empty() ? "" : ", ") + known;
-    throw InputError(kSyntheticPrefix + name + ": no such synthetic input (there are " + names +
-                     ")");
+    throw InputError(std::string(kSyntheticPrefix) + name +
+                     ": no such synthetic input (there are " + names + ")");
   }
   InputData input;
   input.format = "synthetic";
