@@ -14,34 +14,36 @@
 namespace mvog_bench {
 namespace {
 
+/// Every synthetic input has this many scans, scan k from `scan_at(k)`.
+template <class ScanAt>
+std::vector<mvog::Scan> tenScans(const ScanAt& scan_at) {
+  constexpr int kScans = 10;
+  std::vector<mvog::Scan> scans;
+  scans.reserve(kScans);
+  for (int k = 0; k < kScans; ++k) scans.push_back(scan_at(k));
+  return scans;
+}
+
 /// A drive of `lidar` 1.8 m above the street: 10 turns 2 m apart along it, weaving a little.
 std::vector<mvog::Scan> streetDrive(const mvog_scene::RotatingLidar& lidar) {
   constexpr double kMaxRange = 100.0;
-  constexpr int kTurns = 10;
   const mvog_scene::Scene street = mvog_scene::streetScene();
-  std::vector<mvog::Scan> scans;
-  scans.reserve(kTurns);
-  for (int k = 0; k < kTurns; ++k) {
-    scans.push_back(mvog_scene::lidarScan(
-        street, lidar, Eigen::Vector3d(2.0 * k, 0.3 * std::sin(k), 1.8), kMaxRange));
-  }
-  return scans;
+  return tenScans([&](int k) {
+    return mvog_scene::lidarScan(street, lidar, Eigen::Vector3d(2.0 * k, 0.3 * std::sin(k), 1.8),
+                                 kMaxRange);
+  });
 }
 
 /// A tilting laser 0.5 m above the office floor: 10 nods from poses across the room, each turned
 /// 0.3 rad further.
 std::vector<mvog::Scan> officeNods() {
   constexpr double kMaxRange = 30.0;
-  constexpr int kNods = 10;
   const mvog_scene::Scene office = mvog_scene::officeScene();
-  std::vector<mvog::Scan> scans;
-  scans.reserve(kNods);
-  for (int k = 0; k < kNods; ++k) {
-    scans.push_back(mvog_scene::tiltingLaserScan(
-        office, mvog_scene::TiltingLaser(), Eigen::Vector3d(-3.0 + 0.6 * k, 0.2 * k - 1.3, 0.5),
-        0.3 * k, kMaxRange));
-  }
-  return scans;
+  return tenScans([&](int k) {
+    return mvog_scene::tiltingLaserScan(office, mvog_scene::TiltingLaser(),
+                                        Eigen::Vector3d(-3.0 + 0.6 * k, 0.2 * k - 1.3, 0.5),
+                                        0.3 * k, kMaxRange);
+  });
 }
 
 mvog_scene::RotatingLidar thirtyTwoBeams() {  // a Velodyne HDL-32E
