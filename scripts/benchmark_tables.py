@@ -20,6 +20,14 @@ def by_resolution(entries, backend=None):
     }
 
 
+def by_backend(run):
+    """An mvog_bench run's MVOG and OctoMap quality, each backend's results and the comparison,
+    each by resolution."""
+    return (by_resolution(run["quality"], "mvog"), by_resolution(run["quality"], "octomap"),
+            {b: by_resolution(run["results"], b) for b in ("mvog", "octomap", "walk")},
+            by_resolution(run["comparison"]))
+
+
 def file_name(path, prefix):
     return os.path.basename(path)[len(prefix):-len(".json")]
 
@@ -51,11 +59,8 @@ def main(out):
 
     quality, speed, memory, threads = [], [], [], []
     for name, run in runs.items():
-        mvog_quality = by_resolution(run["quality"], "mvog")
-        octomap_quality = by_resolution(run["quality"], "octomap")
+        mvog_quality, octomap_quality, results, comparison = by_backend(run)
         paper_quality = by_resolution(paper[name]["quality"], "mvog") if name in paper else {}
-        results = {b: by_resolution(run["results"], b) for b in ("mvog", "octomap", "walk")}
-        comparison = by_resolution(run["comparison"])
         table_one = by_resolution(run["table_one"])
         for resolution in sorted(mvog_quality, reverse=True):
             m, o = mvog_quality[resolution], octomap_quality[resolution]
@@ -115,11 +120,7 @@ def main(out):
     print(table(["file", "1 thread (s)", "2 threads (s)", "speed-up", "same map"], threads))
     synthetic_rows = []
     for path in sorted(glob.glob(f"{out}/synthetic_*.json")):
-        run = load(path)
-        mvog_quality = by_resolution(run["quality"], "mvog")
-        octomap_quality = by_resolution(run["quality"], "octomap")
-        results = {b: by_resolution(run["results"], b) for b in ("mvog", "octomap", "walk")}
-        comparison = by_resolution(run["comparison"])
+        mvog_quality, octomap_quality, results, comparison = by_backend(load(path))
         for resolution in sorted(mvog_quality, reverse=True):
             m, o = mvog_quality[resolution], octomap_quality[resolution]
             synthetic_rows.append([
