@@ -32,22 +32,20 @@ std::string systemError(const std::string& what, const std::string& path) {
 }  // namespace
 
 std::vector<std::uint8_t> serializeMap(const Map& map) {
-  // Group the volumes by cell (forEachVolume gives a cell's positives, then its negatives).
-  struct CellRecord {
-    CellIndex cell;
-    CellVolumes volumes;
-  };
-  std::vector<CellRecord> cells;
+  // Two passes over the volumes (forEachVolume gives each cell's positives, then its negatives,
+  // a cell at a time): the first counts them for the header, the second writes each cell once
+  // its volumes have passed. Beside the map and its bytes, only one cell's volumes are held.
+  std::size_t cell_count = 0;
   std::size_t volume_count = 0;
-  map.forEachVolume([&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
-    if (cells.empty() || cells.back().cell != cell) cells.push_back({cell, {}});
-    (sign == VolumeSign::kPositive ? cells.back().volumes.positive : cells.back().volumes.negative)
-        .push_back(volume);
+  CellIndex counted{};
+  map.forEachVolume([&](const CellIndex& cell, VolumeSign, const Volume&) {
+    if (volume_count == 0 || cell != counted) ++cell_count;
+    counted = cell;
     ++volume_count;
   });
 
   std::vector<std::uint8_t> out;
-  out.reserve(kMapHeaderBytes + kCellRecordBytes * cells.size() +
+  out.reserve(kMapHeaderBytes + kCellRecordBytes * cell_count +
               detail::kVolumeRecordBytes * volume_count + kChecksumBytes);
   Writer writer(out);
   writer.bytes(kMagic, sizeof(kMagic));
@@ -55,17 +53,27 @@ std::vector<std::uint8_t> serializeMap(const Map& map) {
   writer.u32(static_cast<std::uint32_t>(kMapHeaderBytes));
   writer.f64(map.config().resolution);
   writer.f64(map.config().max_coordinate);
-  writer.u64(cells.size());
+  writer.u64(cell_count);
   writer.u64(volume_count);
   writer.u32(detail::rulesBits(map.config().rules));
   writer.f64(map.config().rules.out_of_range_free_length);
   writer.u32(0);
-  for (const CellRecord& record : cells) {
-    const CellVolumes& v = record.volumes;
-    detail::writeCell(writer, record.cell, v.positive.data(),
-                      static_cast<std::uint32_t>(v.positive.size()), v.negative.data(),
-                      static_cast<std::uint32_t>(v.negative.size()));
-  }
+  CellIndex current{};
+  CellVolumes volumes;
+  auto write_current = [&] {
+    if (volumes.positive.empty() && volumes.negative.empty()) return;
+    detail::writeCell(writer, current, volumes.positive.data(),
+                      static_cast<std::uint32_t>(volumes.positive.size()), volumes.negative.data(),
+                      static_cast<std::uint32_t>(volumes.negative.size()));
+    volumes.positive.clear();
+    volumes.negative.clear();
+  };
+  map.forEachVolume([&](const CellIndex& cell, VolumeSign sign, const Volume& volume) {
+    if (cell != current) write_current();
+    current = cell;
+    (sign == VolumeSign::kPositive ? volumes.positive : volumes.negative).push_back(volume);
+  });
+  write_current();
   writer.checksum();
   return out;
 }
@@ -113,13 +121,24 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     }
   }();
 
+  // The cells go to the map in batches of whole tiles (a file from serializeMap lists a tile's
+  // cells together; any other order only rewrites a tile more than once), so that beside the
+  // bytes and the map only a batch of cells is held.
+  constexpr std::size_t kCellsPerBatch = 4096;
   Reader reader(data, kMapHeaderBytes);
   std::unordered_set<std::uint64_t> seen;
   std::uint64_t volumes_read = 0;
-  std::vector<Map::CellAssignment> assignments;
-  assignments.reserve(cell_count);
+  std::vector<Map::CellAssignment> batch;
+  auto apply_batch = [&] {
+    try {
+      map.setCellVolumes(batch);  // checks the constraints and max_coordinate
+    } catch (const ConfigError& e) {
+      fail(e.what());
+    }
+    batch.clear();
+  };
+  Map::CellAssignment assignment;
   for (std::uint64_t c = 0; c < cell_count; ++c) {
-    Map::CellAssignment& assignment = assignments.emplace_back();
     const std::string problem =
         detail::readCell(reader, volume_count - volumes_read, assignment.cell, assignment.volumes);
     if (!problem.empty()) fail(problem);
@@ -128,13 +147,14 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
       fail(detail::cellName(cell).append(" appears twice"));
     }
     volumes_read += assignment.volumes.positive.size() + assignment.volumes.negative.size();
+    if (batch.size() >= kCellsPerBatch &&
+        detail::tileKeyOf(cell) != detail::tileKeyOf(batch.back().cell)) {
+      apply_batch();
+    }
+    batch.push_back(std::move(assignment));
   }
   if (volumes_read != volume_count) fail("fewer volumes than the header counts");
-  try {
-    map.setCellVolumes(assignments);  // checks the constraints and max_coordinate
-  } catch (const ConfigError& e) {
-    fail(e.what());
-  }
+  apply_batch();
   return map;
 }
 

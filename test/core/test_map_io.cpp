@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -190,6 +191,32 @@ TEST(MapIo, SerializeDeserializeIsTheIdentity) {
   EXPECT_TRUE(test::sameProbabilities(test::probabilityBits(loaded, 3.0, 2.0),
                                       test::probabilityBits(map, 3.0, 2.0)));
   EXPECT_EQ(serializeMap(loaded), bytes);
+}
+
+TEST(MapIo, ReadsManyCellsInAnyOrder) {
+  // A file need not list a tile's cells together, as serializeMap does, and a reader takes its
+  // cells in batches: thousands of cells over many tiles, listed in a shuffled order, read back
+  // as the map they describe; a cell listed twice is refused however far apart its records lie.
+  std::vector<CellRecord> cells;
+  for (std::int32_t x = -60; x < 60; ++x) {
+    for (std::int32_t y = -50; y < 50; ++y) {
+      const auto low = static_cast<float>(x & 3);
+      const auto high = static_cast<float>(y & 3);
+      cells.push_back({x, y, {{0.0f, 1.0f + low, 2.0f}}, {{5.0f + high, 12.0f, 3.0f + low}}});
+    }
+  }
+  std::shuffle(cells.begin(), cells.end(), std::mt19937(7));
+  Map expected(MapConfig{0.5, 100.0, ModelRules{}});
+  std::vector<Map::CellAssignment> assignments;
+  assignments.reserve(cells.size());
+  for (const CellRecord& c : cells) {
+    assignments.push_back({{c.x, c.y}, CellVolumes{c.positive, c.negative}});
+  }
+  expected.setCellVolumes(assignments);
+  const Bytes file = buildFile(0.5, 100.0, cells);
+  EXPECT_EQ(serializeMap(deserializeMap(file.data(), file.size())), serializeMap(expected));
+  cells.push_back(cells.front());
+  EXPECT_TRUE(refused(buildFile(0.5, 100.0, cells)));
 }
 
 TEST(MapIo, DecayedMapRoundTrip) {
