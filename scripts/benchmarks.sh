@@ -82,7 +82,7 @@ done
 # Sensors none of the recordings has, cast into scenes built in code (mvog_bench's synthetic
 # inputs): the quality of the defaults on data they were not tuned on. One insertion each (OctoMap
 # takes about a minute for a drive of the 100 m lidar at 0.05 m).
-for sensor in rotating-lidar-16 rotating-lidar-32 tilting-laser; do
+for sensor in rotating-lidar-16 rotating-lidar-16-firing-order rotating-lidar-32 tilting-laser; do
   REPEAT=1 run_bench "synthetic_$sensor" --input "synthetic:$sensor" --resolution 0.1 \
     --resolution 0.05 --backend all
 done

@@ -67,6 +67,11 @@ struct RotatingLidar {
   double min_elevation_degrees = -15.0;
   double max_elevation_degrees = 15.0;
   double azimuth_step_degrees = 0.2;
+  /// The readings' order in a scan: every beam at one azimuth, then the next azimuth (the
+  /// order of firing, as an unorganised Velodyne cloud), or else each beam's whole turn, then
+  /// the next beam (as the rows of an organised cloud). The map does not depend on it, the
+  /// speed of insertion does.
+  bool firing_order = false;
 };
 
 /// One turn of `lidar` at `position`: a hit where a beam meets a surface within `max_range`,

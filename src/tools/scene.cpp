@@ -115,13 +115,17 @@ mvog::Scan lidarScan(const Scene& scene, const RotatingLidar& lidar,
   mvog::Scan scan;
   scan.origin = position;
   const auto steps = static_cast<int>(std::lround(360.0 / lidar.azimuth_step_degrees));
-  for (int beam = 0; beam < lidar.beams; ++beam) {
-    const double elevation = lidar.beams == 1
-                                 ? lidar.min_elevation_degrees
-                                 : lidar.min_elevation_degrees +
-                                       (lidar.max_elevation_degrees - lidar.min_elevation_degrees) *
-                                           beam / (lidar.beams - 1);
-    for (int step = 0; step < steps; ++step) {
+  const int outer = lidar.firing_order ? steps : lidar.beams;
+  const int inner = lidar.firing_order ? lidar.beams : steps;
+  for (int o = 0; o < outer; ++o) {
+    for (int i = 0; i < inner; ++i) {
+      const int beam = lidar.firing_order ? i : o;
+      const int step = lidar.firing_order ? o : i;
+      const double elevation =
+          lidar.beams == 1 ? lidar.min_elevation_degrees
+                           : lidar.min_elevation_degrees +
+                                 (lidar.max_elevation_degrees - lidar.min_elevation_degrees) *
+                                     beam / (lidar.beams - 1);
       castReading(scene, position,
                   unitDirection(radians(step * lidar.azimuth_step_degrees), radians(elevation)),
                   max_range, scan);

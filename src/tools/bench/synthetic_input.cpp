@@ -57,6 +57,12 @@ mvog_scene::RotatingLidar thirtyTwoBeams() {  // a Velodyne HDL-32E
 const std::map<std::string, std::function<std::vector<mvog::Scan>()>>& sensors() {
   static const std::map<std::string, std::function<std::vector<mvog::Scan>()>> kSensors = {
       {"rotating-lidar-16", [] { return streetDrive(mvog_scene::RotatingLidar()); }},
+      {"rotating-lidar-16-firing-order",
+       [] {
+         mvog_scene::RotatingLidar lidar;
+         lidar.firing_order = true;
+         return streetDrive(lidar);
+       }},
       {"rotating-lidar-32", [] { return streetDrive(thirtyTwoBeams()); }},
       {"tilting-laser", officeNods},
   };
