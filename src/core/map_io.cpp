@@ -137,8 +137,8 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     }
     batch.clear();
   };
-  Map::CellAssignment assignment;
   for (std::uint64_t c = 0; c < cell_count; ++c) {
+    Map::CellAssignment assignment;
     const std::string problem =
         detail::readCell(reader, volume_count - volumes_read, assignment.cell, assignment.volumes);
     if (!problem.empty()) fail(problem);
