@@ -30,8 +30,11 @@ struct ScanInterval {
 };
 
 /// A column's free space so far in one scan: the interval its last ray reached inline, so that
-/// the next ray, which mostly reaches the same interval, grows it inline. 16 bytes: a scan's
-/// slots are most of what its rasterisation reads and writes.
+/// the next ray, which mostly reaches the same interval, grows it inline, whether or not the
+/// column holds other intervals (OtherIntervals): the inline interval may grow over some of
+/// them, which join it when it next goes among them (ScanScratch::addFreeSlow) or is read
+/// (ScanScratch::appendFree). 16 bytes: a scan's slots are most of what its rasterisation reads
+/// and writes.
 struct FreeSlot {
   float bottom;
   float top;
@@ -53,13 +56,9 @@ inline std::uint64_t slotTag(std::uint32_t stamp, std::uint32_t others) {
   return stamp | std::uint64_t{others} << 32;
 }
 
-/// The intervals of a column with several, but for the one inline in its slot (sorted), and the
-/// nearest of them below and above the inline one, which the next ray may grow it up to.
-struct OtherIntervals {
-  std::vector<ScanInterval> intervals;
-  float below;  ///< top of the next interval below the inline one, or -infinity
-  float above;  ///< bottom of the next interval above it, or +infinity
-};
+/// The intervals of a column with several, but for the one inline in its slot: sorted, more than
+/// the join gap apart.
+using OtherIntervals = std::vector<ScanInterval>;
 
 /// A hit's positive volume (eq. 5) in a cell of a tile.
 struct TileHit {
@@ -146,8 +145,8 @@ class ScanScratch {
       }
     }
 
-    /// Called for every cell a ray crosses: the commonest case (the interval inline grows and
-    /// reaches no other) stays inline in the ray walk.
+    /// Called for every cell a ray crosses: the commonest case (the interval inline grows)
+    /// stays inline in the ray walk.
     void addFree(const Volume& volume) {
       ScratchTile& tile = currentTile();
       const unsigned local = currentLocal();
@@ -157,13 +156,13 @@ class ScanScratch {
         return;
       }
       FreeSlot& slot = tile.slots[local];
-      if (slot.tag == inline_only_) {
+      if (slot.stamp() == stamp_) {
         if (intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_)) {
           slot.grow(volume);
           if (kCountMasses) tile.masses[local] += volume.mass;
           return;
         }
-      } else if (slot.stamp() != stamp_) {  // the cell's first interval of this scan
+      } else {  // the cell's first interval of this scan
         slot = {volume.bottom, volume.top, inline_only_};
         if (kCountMasses) tile.masses[local] = volume.mass;
         tile.markReached(local);
@@ -234,8 +233,8 @@ class ScanScratch {
   ScratchTile& findOrAddTile(std::int32_t tile_x, std::int32_t tile_y);
   /// A hit's volume in cell `local` of `tile` (out of line: once a ray, not in its walk's loop).
   void addHit(ScratchTile& tile, unsigned local, const Volume& volume);
-  /// An interval that does more than grow the inline interval of a slot of this scan and
-  /// column that holds no other interval.
+  /// An interval that does not reach the inline interval of a slot of this scan: the inline
+  /// one goes among the others and the new one comes inline, each joined with those it reaches.
   void addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume);
 
   /// The tiles reached, by key, and the index from tile to scratch: dense over the scan's tiles

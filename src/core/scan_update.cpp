@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <utility>
 
 #include "mvog/raster.h"
 #include "scan_scratch.h"
@@ -71,56 +72,52 @@ ScratchTile& ScanScratch::findOrAddTile(std::int32_t tile_x, std::int32_t tile_y
   return **slot;
 }
 
+namespace {
+
+/// The run of the intervals in [begin, end) (sorted, more than `join_gap` apart) that `interval`
+/// reaches, joined into it: their union reaches no other. The run is empty, at the first
+/// interval above, if it reaches none.
+template <class Iterator>
+std::pair<Iterator, Iterator> joinReached(Iterator begin, Iterator end, ScanInterval& interval,
+                                          float join_gap) {
+  Iterator first = begin;
+  while (first != end && !joins(first->top, interval.bottom, join_gap)) ++first;
+  Iterator last = first;
+  for (; last != end && joins(interval.top, last->bottom, join_gap); ++last) {
+    interval.bottom = std::min(interval.bottom, last->bottom);
+    interval.top = std::max(interval.top, last->top);
+    interval.mass += last->mass;
+  }
+  return {first, last};
+}
+
+/// Joins `interval` with the intervals of `list` that it reaches and removes them from the
+/// list; returns where the joined interval belongs in it.
+OtherIntervals::iterator takeReached(OtherIntervals& list, ScanInterval& interval, float join_gap) {
+  const auto [first, last] = joinReached(list.begin(), list.end(), interval, join_gap);
+  return list.erase(first, last);
+}
+
+}  // namespace
+
 void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume) {
-  constexpr float kInfinity = std::numeric_limits<float>::infinity();
   FreeSlot& slot = tile.slots[local];
-  const double mass = count_masses_ ? static_cast<double>(volume.mass) : 0.0;
   if (slot.others() == kNoOthers) {
     if (others_used_ == others_.size()) others_.emplace_back();
     slot.tag = slotTag(stamp_, static_cast<std::uint32_t>(others_used_++));
-    others_[slot.others()].intervals.clear();
-  } else if (const OtherIntervals& others = others_[slot.others()];
-             intervalsJoin(volume.bottom, volume.top, slot.bottom, slot.top, join_gap_) &&
-             std::min(volume.bottom - others.below, others.above - volume.top) > join_gap_) {
-    // It grows the inline interval and reaches none of the others.
-    slot.grow(volume);
-    if (count_masses_) tile.masses[local] += mass;
-    return;
+    others_[slot.others()].clear();
   }
-  // The volume joins the inline interval if it reaches it, and the run of other intervals it
-  // reaches (a column's intervals lie more than join_gap apart: what the volume reaches is one
-  // run, and their union reaches nothing more, nor the inline interval if the volume does not).
-  // The union goes inline; an inline interval it did not take goes among the others.
+  // The inline interval, which may have grown over some of the others (Writer::addFree grows it
+  // without looking at them), goes among them; the volume comes inline with what it reaches.
   OtherIntervals& others = others_[slot.others()];
-  std::vector<ScanInterval>& list = others.intervals;
-  const ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
-  ScanInterval joined{volume.bottom, volume.top, mass};
-  const bool joins_current =
-      intervalsJoin(volume.bottom, volume.top, current.bottom, current.top, join_gap_);
-  if (joins_current) {
-    joined = {std::min(joined.bottom, current.bottom), std::max(joined.top, current.top),
-              joined.mass + current.mass};
-  }
-  auto first = list.begin();
-  while (first != list.end() && !joins(first->top, joined.bottom, join_gap_)) ++first;
-  auto last = first;
-  for (; last != list.end() && joins(joined.top, last->bottom, join_gap_); ++last) {
-    joined.bottom = std::min(joined.bottom, last->bottom);
-    joined.top = std::max(joined.top, last->top);
-    joined.mass += last->mass;
-  }
-  list.erase(first, last);
-  auto below_of = [&list](float bottom) {  // the first interval not wholly below `bottom`
-    return std::partition_point(list.begin(), list.end(),
-                                [bottom](const ScanInterval& i) { return i.top < bottom; });
-  };
-  if (!joins_current) list.insert(below_of(current.bottom), current);
+  ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
+  others.insert(takeReached(others, current, join_gap_), current);
+  ScanInterval joined{volume.bottom, volume.top,
+                      count_masses_ ? static_cast<double>(volume.mass) : 0.0};
+  takeReached(others, joined, join_gap_);
   slot.bottom = joined.bottom;
   slot.top = joined.top;
-  tile.masses[local] = joined.mass;
-  const auto next = below_of(joined.bottom);
-  others.below = next == list.begin() ? -kInfinity : std::prev(next)->top;
-  others.above = next == list.end() ? kInfinity : next->bottom;
+  if (count_masses_) tile.masses[local] = joined.mass;
 }
 
 void ScanScratch::addHit(ScratchTile& tile, unsigned local, const Volume& volume) {
@@ -161,16 +158,13 @@ void ScanScratch::appendFree(const ScratchTile& tile, unsigned local,
     out.push_back(current);
     return;
   }
-  const std::vector<ScanInterval>& list = others_[slot.others()].intervals;
-  bool placed = false;
-  for (const ScanInterval& i : list) {
-    if (!placed && current.bottom < i.bottom) {
-      out.push_back(current);
-      placed = true;
-    }
-    out.push_back(i);
-  }
-  if (!placed) out.push_back(current);
+  // The inline interval joined with the others it grew over (see addFreeSlow), in their order.
+  const OtherIntervals& others = others_[slot.others()];
+  ScanInterval joined = current;
+  const auto [first, last] = joinReached(others.begin(), others.end(), joined, join_gap_);
+  out.insert(out.end(), others.begin(), first);
+  out.push_back(joined);
+  out.insert(out.end(), last, others.end());
 }
 
 namespace {
