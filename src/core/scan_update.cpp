@@ -111,10 +111,31 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
   // without looking at them), goes among them; the volume comes inline with what it reaches.
   OtherIntervals& others = others_[slot.others()];
   ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
-  others.insert(takeReached(others, current, join_gap_), current);
-  ScanInterval joined{volume.bottom, volume.top,
-                      count_masses_ ? static_cast<double>(volume.mass) : 0.0};
-  takeReached(others, joined, join_gap_);
+  const ScanInterval added{volume.bottom, volume.top,
+                           count_masses_ ? static_cast<double>(volume.mass) : 0.0};
+  ScanInterval joined = added;
+  const auto [current_first, current_last] =
+      joinReached(others.begin(), others.end(), current, join_gap_);
+  const auto [taken, taken_last] = joinReached(others.begin(), others.end(), joined, join_gap_);
+  if (current_first == current_last && taken_last - taken <= 1) {
+    // The commonest case (a lidar's next beam): the inline interval reaches none of the others
+    // and the volume reaches one at most, which the inline one replaces, those between the two
+    // places shifted by one to keep their order (no volume reaches the inline interval here).
+    const auto place = current_first;  // where the inline interval belongs among the others
+    if (taken == taken_last) {
+      others.insert(place, current);
+    } else if (place <= taken) {
+      std::move_backward(place, taken, taken + 1);
+      *place = current;
+    } else {
+      std::move(taken + 1, place, taken);
+      *(place - 1) = current;
+    }
+  } else {
+    others.insert(others.erase(current_first, current_last), current);
+    joined = added;
+    takeReached(others, joined, join_gap_);
+  }
   slot.bottom = joined.bottom;
   slot.top = joined.top;
   if (count_masses_) tile.masses[local] = joined.mass;
