@@ -121,9 +121,11 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     }
   }();
 
-  // The cells go to the map in batches of whole tiles (a file from serializeMap lists a tile's
-  // cells together; any other order only rewrites a tile more than once), so that beside the
-  // bytes and the map only a batch of cells is held.
+  // The cells go to the map in batches of whole tiles, so that beside the bytes and the map only
+  // a batch of cells is held (and `seen`, a key a cell). A file from serializeMap lists a tile's
+  // cells together; in another order a batch rewrites every tile it touches, up to once a cell
+  // (slower, the same map). A batch's constraint error may come before a later cell's format
+  // error; a failed read discards the map either way.
   constexpr std::size_t kCellsPerBatch = 4096;
   Reader reader(data, kMapHeaderBytes);
   std::unordered_set<std::uint64_t> seen;

@@ -39,8 +39,8 @@ struct FreeSlot {
   float bottom;
   float top;
   /// The stamp of the scan the slot holds (so that no slot needs clearing between scans), and
-  /// the index of the column's other intervals (OtherIntervals) or kNoOthers: one word, which
-  /// the commonest visit (a slot of this scan without others) tests at once (slotTag).
+  /// the index of the column's other intervals (OtherIntervals) or kNoOthers: one word (slotTag).
+  /// A visit tests its stamp; singleFree, whether it is this scan's without others.
   std::uint64_t tag;
   std::uint32_t stamp() const { return static_cast<std::uint32_t>(tag); }
   std::uint32_t others() const { return static_cast<std::uint32_t>(tag >> 32); }
@@ -69,7 +69,8 @@ struct TileHit {
 
 struct ScratchTile {
   FreeSlot slots[kCellsPerTile];
-  /// With MassCounting::kPerReading: the mass of each slot's inline interval.
+  /// With MassCounting::kPerReading: the mass of the volumes each slot's inline interval took
+  /// (the other intervals it grew over keep theirs until they join it).
   double masses[kCellsPerTile];
   std::vector<TileHit> hits;
   /// Bit k: cell k got a hit, or (but in a level scan) free space in this scan (so that applying

@@ -119,8 +119,9 @@ void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& v
   const auto [taken, taken_last] = joinReached(others.begin(), others.end(), joined, join_gap_);
   if (current_first == current_last && taken_last - taken <= 1) {
     // The commonest case (a lidar's next beam): the inline interval reaches none of the others
-    // and the volume reaches one at most, which the inline one replaces, those between the two
-    // places shifted by one to keep their order (no volume reaches the inline interval here).
+    // and the volume reaches one at most. The inline interval is inserted among them, or
+    // replaces the one reached, those between the two places shifted by one to keep their order
+    // (the volume never reaches the inline interval here).
     const auto place = current_first;  // where the inline interval belongs among the others
     if (taken == taken_last) {
       others.insert(place, current);
