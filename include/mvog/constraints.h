@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <tuple>
 #include <vector>
 
 #include "mvog/volume.h"
@@ -85,6 +86,13 @@ class ListMerger {
     std::size_t first_gap;
     std::size_t end_gap;
   };
+  /// Sorted by every field, so that the sums of the merge run in an order the set alone decides.
+  static bool sourceBefore(const Source& a, const Source& b) {
+    return std::tie(a.bottom, a.top, a.mass) < std::tie(b.bottom, b.top, b.mass);
+  }
+  /// merge() of a list without obstacles (a positive list, or a negative one in a column that
+  /// holds none), the added volumes sorted in added_.
+  void mergeWithoutObstacles(VolumeRun existing, float unit_mass, std::vector<Volume>& out);
   void sweep();
   /// Appends the pieces of the component [bottom, top] cut at the obstacles within it.
   static void cutAtObstacles(float bottom, float top, const Volume* first_obstacle,
@@ -101,6 +109,7 @@ class ListMerger {
   std::vector<Component> components_;  // upwards
   std::vector<Volume> pieces_;         // keepsUnchanged's cut of one run
   std::vector<Volume> cut_;            // cutAsTheMergeDoes's result
+  std::vector<double> gap_masses_;     // mergeWithoutObstacles's gaps of one piece
 };
 
 }  // namespace mvog

@@ -1,7 +1,6 @@
 #include "mvog/constraints.h"
 
 #include <algorithm>
-#include <tuple>
 
 namespace mvog {
 
@@ -27,20 +26,20 @@ void ListMerger::merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles,
   out.clear();
   sources_.clear();
   inside_.clear();
-  // Sorted by every field, so that the sums below run in an order the set alone decides.
-  auto before = [](const Source& a, const Source& b) {
-    return std::tie(a.bottom, a.top, a.mass) < std::tie(b.bottom, b.top, b.mass);
-  };
   // The existing list is sorted; the added volumes mostly are too (one scan's are).
   added_.clear();
   for (const Volume& v : added) added_.push_back({v.bottom, v.top, v.mass});
-  if (!std::is_sorted(added_.begin(), added_.end(), before)) {
-    std::sort(added_.begin(), added_.end(), before);
+  if (!std::is_sorted(added_.begin(), added_.end(), sourceBefore)) {
+    std::sort(added_.begin(), added_.end(), sourceBefore);
+  }
+  if (obstacles.size == 0) {
+    mergeWithoutObstacles(existing, unit_mass, out);
+    return;
   }
   std::size_t next_added = 0;
   for (const Volume& v : existing) {
     const Source s{v.bottom, v.top, v.mass};
-    while (next_added < added_.size() && before(added_[next_added], s)) {
+    while (next_added < added_.size() && sourceBefore(added_[next_added], s)) {
       sources_.push_back(added_[next_added++]);
     }
     sources_.push_back(s);
@@ -71,6 +70,49 @@ void ListMerger::merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles,
     gap.mass = free_length * unit_mass;
   }
   for (const Component& component : components_) addPieces(component, out);
+}
+
+void ListMerger::mergeWithoutObstacles(VolumeRun existing, float unit_mass,
+                                       std::vector<Volume>& out) {
+  // What sweep() and addPieces() give when no obstacle is inside: each component is one piece,
+  // whose mass sums its sources in their order (existing before added at equal keys, as the
+  // sources are merged above), then its gaps upwards. In one pass, without the sources' list.
+  const Volume* next_existing = existing.begin();
+  std::size_t next_added = 0;
+  Source piece{0.0f, 0.0f, 0.0};
+  bool open = false;
+  auto close_piece = [&] {
+    double mass = piece.mass;
+    for (double gap_mass : gap_masses_) mass += gap_mass;
+    out.push_back({piece.bottom, piece.top, static_cast<float>(mass)});
+    gap_masses_.clear();
+  };
+  gap_masses_.clear();
+  while (next_existing != existing.end() || next_added < added_.size()) {
+    Source s;
+    if (next_added < added_.size() &&
+        (next_existing == existing.end() ||
+         sourceBefore(added_[next_added],
+                      {next_existing->bottom, next_existing->top, next_existing->mass}))) {
+      s = added_[next_added++];
+    } else {
+      s = {next_existing->bottom, next_existing->top, next_existing->mass};
+      ++next_existing;
+    }
+    if (open && mustMerge(piece.top, s.bottom)) {
+      // Eq. (8): the gap's free length at density 1 (no obstacle covers any of it).
+      if (s.bottom > piece.top) {
+        gap_masses_.push_back((static_cast<double>(s.bottom) - piece.top) * unit_mass);
+      }
+      piece.top = std::max(piece.top, s.top);
+      piece.mass += s.mass;
+      continue;
+    }
+    if (open) close_piece();
+    piece = s;
+    open = true;
+  }
+  if (open) close_piece();
 }
 
 void ListMerger::sweep() {

@@ -80,8 +80,6 @@ struct ColumnWork {
   std::vector<ScanInterval> positive;
   CellVolumes added;
   CellVolumes merged;
-  std::vector<Volume> existing_positive;
-  std::vector<Volume> existing_negative;
   /// The new lists of the tile's cells whose lists changed length.
   detail::TileBlock::Rewrite rewrite;
   CellRange grown = kNoCells;  // cells that received their first volume
@@ -370,17 +368,20 @@ bool mergeWithoutContact(const detail::ColumnRef& existing, const CellVolumes& a
           : addWithinExistingVolumes(work.added, existing, free_space_rules, work.merger)) {
     return;
   }
-  if (!mergeWithoutContact(existing, work.added, free_space_rules, work.merger, work.merged)) {
-    work.existing_positive.assign(existing.positive, existing.positive + existing.num_positive);
-    work.existing_negative.assign(existing.negative, existing.negative + existing.num_negative);
+  // A column without obstacles, before and after, is merged in one pass by ListMerger: no need
+  // to try mergeWithoutContact first.
+  const bool without_obstacles = existing.num_positive == 0 && work.added.positive.empty();
+  if (without_obstacles ||
+      !mergeWithoutContact(existing, work.added, free_space_rules, work.merger, work.merged)) {
+    const VolumeRun existing_positive(existing.positive, existing.num_positive);
     if (work.added.positive.empty()) {
-      work.merged.positive = work.existing_positive;
+      work.merged.positive.assign(existing_positive.begin(), existing_positive.end());
     } else {
-      work.merger.merge(work.existing_positive, work.added.positive, {}, {}, unit_mass,
+      work.merger.merge(existing_positive, work.added.positive, {}, {}, unit_mass,
                         work.merged.positive);
     }
-    work.merger.merge(work.existing_negative, work.added.negative, work.merged.positive,
-                      free_space_rules, unit_mass, work.merged.negative);
+    work.merger.merge(VolumeRun(existing.negative, existing.num_negative), work.added.negative,
+                      work.merged.positive, free_space_rules, unit_mass, work.merged.negative);
   }
   const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
   const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());

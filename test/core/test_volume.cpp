@@ -358,6 +358,38 @@ TEST(ListMerger, TheResultDependsOnTheSetOfVolumesNotTheirOrder) {
   }
 }
 
+TEST(ListMerger, AListWithoutObstaclesMergesAsOneBesideAnObstacleItDoesNotReach) {
+  // A list without obstacles takes a one-pass merge; beside an obstacle it takes the sweep. Where
+  // the obstacle lies out of reach, both must give the same list bit for bit: the same volumes,
+  // gaps closed, and masses (decayed, so not whole heights; a unit below 1) summed alike.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> bottom(-20.0f, 20.0f);
+  std::uniform_real_distribution<float> height(0.0f, 4.0f);
+  std::uniform_real_distribution<float> density(0.1f, 3.0f);
+  const auto decayed = [&](float b) {
+    Volume v = makeVolume(b, b + height(rng));
+    v.mass = v.height() * density(rng);
+    return v;
+  };
+  const std::vector<Volume> far_obstacle = {fresh(1000.0f, 1001.0f)};
+  for (int trial = 0; trial < 500; ++trial) {
+    std::vector<Volume> existing;
+    for (int k = 0; k < 6; ++k) existing = inserted(existing, decayed(bottom(rng)), 0.8314f);
+    std::vector<Volume> added;
+    for (int k = 0; k < 10; ++k) added.push_back(decayed(bottom(rng)));
+    const std::vector<Volume> alone = merged(existing, added, 0.8314f);
+    for (const FreeSpaceRules rules : {FreeSpaceRules{true, true}, FreeSpaceRules{false, false}}) {
+      ListMerger merger;
+      std::vector<Volume> beside;
+      merger.merge(existing, added, far_obstacle, rules, 0.8314f, beside);
+      ASSERT_EQ(beside.size(), alone.size()) << "trial " << trial;
+      for (std::size_t k = 0; k < beside.size(); ++k) {
+        ASSERT_EQ(std::memcmp(&beside[k], &alone[k], sizeof(Volume)), 0) << "trial " << trial;
+      }
+    }
+  }
+}
+
 // ---- Sec. V.C: free space split at obstacles (ModelRules::split_free_space_at_obstacles) ------
 
 /// `negative` with `added` merged in next to the obstacles `positive`, with the model's rules.
