@@ -1,7 +1,6 @@
 #pragma once
 
 #include <cstddef>
-#include <tuple>
 #include <vector>
 
 #include "mvog/volume.h"
@@ -88,7 +87,8 @@ class ListMerger {
   };
   /// Sorted by every field, so that the sums of the merge run in an order the set alone decides.
   static bool sourceBefore(const Source& a, const Source& b) {
-    return std::tie(a.bottom, a.top, a.mass) < std::tie(b.bottom, b.top, b.mass);
+    return a.bottom < b.bottom ||
+           (a.bottom == b.bottom && (a.top < b.top || (a.top == b.top && a.mass < b.mass)));
   }
   /// merge() of a list without obstacles (a positive list, or a negative one in a column that
   /// holds none), the added volumes sorted in added_.

@@ -75,10 +75,12 @@ void ListMerger::merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles,
 void ListMerger::mergeWithoutObstacles(VolumeRun existing, float unit_mass,
                                        std::vector<Volume>& out) {
   // What sweep() and addPieces() give when no obstacle is inside: each component is one piece,
-  // whose mass sums its sources in their order (existing before added at equal keys, as the
-  // sources are merged above), then its gaps upwards. In one pass, without the sources' list.
+  // whose mass sums its sources in their order, then its gaps upwards. In one pass, without the
+  // sources' list.
   const Volume* next_existing = existing.begin();
-  std::size_t next_added = 0;
+  const Source* next_added = added_.data();
+  const Source* const end_added = next_added + added_.size();
+  out.reserve(existing.size + added_.size());
   Source piece{0.0f, 0.0f, 0.0};
   bool open = false;
   auto close_piece = [&] {
@@ -88,15 +90,14 @@ void ListMerger::mergeWithoutObstacles(VolumeRun existing, float unit_mass,
     gap_masses_.clear();
   };
   gap_masses_.clear();
-  while (next_existing != existing.end() || next_added < added_.size()) {
+  while (next_existing != existing.end() || next_added != end_added) {
     Source s;
-    if (next_added < added_.size() &&
-        (next_existing == existing.end() ||
-         sourceBefore(added_[next_added],
-                      {next_existing->bottom, next_existing->top, next_existing->mass}))) {
-      s = added_[next_added++];
-    } else {
+    if (next_existing != existing.end())
       s = {next_existing->bottom, next_existing->top, next_existing->mass};
+    if (next_added != end_added &&
+        (next_existing == existing.end() || sourceBefore(*next_added, s))) {
+      s = *next_added++;
+    } else {
       ++next_existing;
     }
     if (open && mustMerge(piece.top, s.bottom)) {
