@@ -74,9 +74,11 @@ void ListMerger::merge(VolumeRun existing, VolumeRun added, VolumeRun obstacles,
 
 void ListMerger::mergeWithoutObstacles(VolumeRun existing, float unit_mass,
                                        std::vector<Volume>& out) {
-  // What sweep() and addPieces() give when no obstacle is inside: each component is one piece,
-  // whose mass sums its sources in their order, then its gaps upwards. In one pass, without the
+  // What sweep() and addPieces() give when there are no obstacles: each component is one piece,
+  // whose mass sums, from 0.0, its sources in their order, then its gaps upwards (as massWithin
+  // does, so that even a mass of -0 comes out as it does there). In one pass, without the
   // sources' list.
+  auto source_of = [](const Volume& v) { return Source{v.bottom, v.top, v.mass}; };
   const Volume* next_existing = existing.begin();
   const Source* next_added = added_.data();
   const Source* const end_added = next_added + added_.size();
@@ -91,15 +93,10 @@ void ListMerger::mergeWithoutObstacles(VolumeRun existing, float unit_mass,
   };
   gap_masses_.clear();
   while (next_existing != existing.end() || next_added != end_added) {
-    Source s;
-    if (next_existing != existing.end())
-      s = {next_existing->bottom, next_existing->top, next_existing->mass};
-    if (next_added != end_added &&
-        (next_existing == existing.end() || sourceBefore(*next_added, s))) {
-      s = *next_added++;
-    } else {
-      ++next_existing;
-    }
+    const bool take_added =
+        next_added != end_added &&
+        (next_existing == existing.end() || sourceBefore(*next_added, source_of(*next_existing)));
+    const Source s = take_added ? *next_added++ : source_of(*next_existing++);
     if (open && mustMerge(piece.top, s.bottom)) {
       // Eq. (8): the gap's free length at density 1 (no obstacle covers any of it).
       if (s.bottom > piece.top) {
@@ -110,7 +107,7 @@ void ListMerger::mergeWithoutObstacles(VolumeRun existing, float unit_mass,
       continue;
     }
     if (open) close_piece();
-    piece = s;
+    piece = {s.bottom, s.top, 0.0 + s.mass};
     open = true;
   }
   if (open) close_piece();
