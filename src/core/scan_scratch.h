@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -56,9 +57,14 @@ inline std::uint64_t slotTag(std::uint32_t stamp, std::uint32_t others) {
   return stamp | std::uint64_t{others} << 32;
 }
 
-/// The intervals of a column with several, but for the one inline in its slot: sorted, more than
-/// the join gap apart.
-using OtherIntervals = std::vector<ScanInterval>;
+/// The intervals of a column with several, but for the one inline in its slot (sorted, more than
+/// the join gap apart): a run of the scan's arena of intervals, with room for `capacity`
+/// (ScanScratch::heights_ and masses_).
+struct OtherIntervals {
+  std::size_t offset;
+  std::uint32_t size;
+  std::uint32_t capacity;
+};
 
 /// A hit's positive volume (eq. 5) in a cell of a tile.
 struct TileHit {
@@ -237,6 +243,57 @@ class ScanScratch {
   /// An interval that does not reach the inline interval of a slot of this scan: the inline
   /// one goes among the others and the new one comes inline, each joined with those it reaches.
   void addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume);
+  /// The heights of an interval in the arena (its mass, if counted, at the same place in
+  /// masses_): 8 bytes, half a ScanInterval, since a rotating lidar's columns hold many.
+  struct Heights {
+    float bottom;
+    float top;
+  };
+  /// A column's first other intervals get a cache line's room (most hold a few).
+  static constexpr std::uint32_t kFirstCapacity = 64 / sizeof(Heights);
+  /// Room in the arena for `capacity` intervals (kFirstCapacity times a power of two): its
+  /// offset.
+  std::size_t allocate(std::uint32_t capacity);
+  /// Moves `others`, which is full, to room twice as large; the room it leaves goes to a run
+  /// that grows later.
+  void moveToLargerRoom(OtherIntervals& others);
+  ScanInterval intervalAt(std::size_t index) const {
+    return {heights_[index].bottom, heights_[index].top, count_masses_ ? masses_[index] : 0.0};
+  }
+  void setInterval(std::size_t index, const ScanInterval& interval) {
+    heights_[index] = {interval.bottom, interval.top};
+    if (count_masses_) masses_[index] = interval.mass;
+  }
+  /// Moves the arena's intervals [from, from + count) to `to` (the two may overlap).
+  void moveIntervals(std::size_t from, std::size_t count, std::size_t to) {
+    std::memmove(heights_.get() + to, heights_.get() + from, count * sizeof(Heights));
+    if (count_masses_) {
+      std::memmove(masses_.get() + to, masses_.get() + from, count * sizeof(double));
+    }
+  }
+  /// Replaces the intervals [first, last) of `others`, which has room for one more, by
+  /// `interval`.
+  void replaceRange(OtherIntervals& others, std::size_t first, std::size_t last,
+                    const ScanInterval& interval) {
+    moveIntervals(last, others.offset + others.size - last, first + 1);
+    setInterval(first, interval);
+    others.size = static_cast<std::uint32_t>(others.size + 1 - (last - first));
+  }
+  /// The run [first, last) of the arena's intervals in [begin, end) (sorted, more than the join
+  /// gap apart) that `interval` reaches, joined into it: their union reaches no other. The run is
+  /// empty, at the first interval above, if it reaches none.
+  std::pair<std::size_t, std::size_t> joinReached(std::size_t begin, std::size_t end,
+                                                  ScanInterval& interval) const {
+    std::size_t first = begin;
+    while (first != end && !joins(heights_[first].top, interval.bottom, join_gap_)) ++first;
+    std::size_t last = first;
+    for (; last != end && joins(interval.top, heights_[last].bottom, join_gap_); ++last) {
+      interval.bottom = std::min(interval.bottom, heights_[last].bottom);
+      interval.top = std::max(interval.top, heights_[last].top);
+      if (count_masses_) interval.mass += masses_[last];
+    }
+    return {first, last};
+  }
 
   /// The tiles reached, by key, and the index from tile to scratch: dense over the scan's tiles
   /// when they are few enough, else hashed.
@@ -249,9 +306,18 @@ class ScanScratch {
   std::vector<ScratchTile*> dense_;
   std::unordered_map<std::uint64_t, ScratchTile*> hashed_;
   std::vector<std::unique_ptr<ScratchTile>> pool_;
-  /// The other intervals of columns with several.
+  /// The other intervals of columns with several (FreeSlot::others indexes this scan's), runs of
+  /// one arena: the first arena_used_ intervals are this scan's.
   std::vector<OtherIntervals> others_;
-  std::size_t others_used_ = 0;
+  /// Left uninitialised: pages not yet written (masses_ when masses are not counted) take no
+  /// memory.
+  std::unique_ptr<Heights[]> heights_;
+  std::unique_ptr<double[]> masses_;
+  std::size_t arena_capacity_ = 0;
+  std::size_t arena_used_ = 0;
+  /// The room runs left when they moved (moveToLargerRoom), by capacity: kFirstCapacity <<
+  /// index.
+  std::vector<std::vector<std::size_t>> free_runs_;
   std::uint32_t stamp_ = 0;
   float join_gap_ = 0.0f;
   bool count_masses_ = false;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <iterator>
 #include <limits>
 #include <utility>
@@ -40,7 +41,9 @@ void ScanScratch::begin(float join_gap, bool count_masses, const CellRange& tile
   level_volume_ = level_ ? *level : Volume{};
   reached_.clear();
   hashed_.clear();
-  others_used_ = 0;
+  others_.clear();
+  arena_used_ = 0;
+  for (auto& runs : free_runs_) runs.clear();
   const bool dense = !tiles.empty() && tiles.width() * tiles.height() <= kMaxDenseTiles;
   dense_min_x_ = dense ? tiles.min.x : 0;
   dense_min_y_ = dense ? tiles.min.y : 0;
@@ -72,70 +75,81 @@ ScratchTile& ScanScratch::findOrAddTile(std::int32_t tile_x, std::int32_t tile_y
   return **slot;
 }
 
-namespace {
-
-/// The run of the intervals in [begin, end) (sorted, more than `join_gap` apart) that `interval`
-/// reaches, joined into it: their union reaches no other. The run is empty, at the first
-/// interval above, if it reaches none.
-template <class Iterator>
-std::pair<Iterator, Iterator> joinReached(Iterator begin, Iterator end, ScanInterval& interval,
-                                          float join_gap) {
-  Iterator first = begin;
-  while (first != end && !joins(first->top, interval.bottom, join_gap)) ++first;
-  Iterator last = first;
-  for (; last != end && joins(interval.top, last->bottom, join_gap); ++last) {
-    interval.bottom = std::min(interval.bottom, last->bottom);
-    interval.top = std::max(interval.top, last->top);
-    interval.mass += last->mass;
+std::size_t ScanScratch::allocate(std::uint32_t capacity) {
+  // Room that a run left when it moved (moveToLargerRoom) is reused first.
+  const auto size_class = static_cast<std::size_t>(lowestBit(capacity / kFirstCapacity));
+  if (size_class < free_runs_.size() && !free_runs_[size_class].empty()) {
+    const std::size_t offset = free_runs_[size_class].back();
+    free_runs_[size_class].pop_back();
+    return offset;
   }
-  return {first, last};
+  const std::size_t offset = arena_used_;
+  arena_used_ += capacity;
+  if (arena_used_ > arena_capacity_) {
+    const std::size_t grown = std::max(arena_used_, 2 * arena_capacity_);
+    std::unique_ptr<Heights[]> heights(new Heights[grown]);
+    std::unique_ptr<double[]> masses(new double[grown]);
+    // Copied as bytes: the room of a run beyond its size was never written.
+    if (offset > 0) std::memcpy(heights.get(), heights_.get(), offset * sizeof(Heights));
+    if (offset > 0 && count_masses_)
+      std::memcpy(masses.get(), masses_.get(), offset * sizeof(double));
+    heights_ = std::move(heights);
+    masses_ = std::move(masses);
+    arena_capacity_ = grown;
+  }
+  return offset;
 }
 
-/// Joins `interval` with the intervals of `list` that it reaches and removes them from the
-/// list; returns where the joined interval belongs in it.
-OtherIntervals::iterator takeReached(OtherIntervals& list, ScanInterval& interval, float join_gap) {
-  const auto [first, last] = joinReached(list.begin(), list.end(), interval, join_gap);
-  return list.erase(first, last);
+void ScanScratch::moveToLargerRoom(OtherIntervals& others) {
+  const std::size_t offset = allocate(2 * others.capacity);
+  moveIntervals(others.offset, others.size, offset);
+  const auto size_class = static_cast<std::size_t>(lowestBit(others.capacity / kFirstCapacity));
+  if (size_class >= free_runs_.size()) free_runs_.resize(size_class + 1);
+  free_runs_[size_class].push_back(others.offset);
+  others.offset = offset;
+  others.capacity *= 2;
 }
-
-}  // namespace
 
 void ScanScratch::addFreeSlow(ScratchTile& tile, unsigned local, const Volume& volume) {
   FreeSlot& slot = tile.slots[local];
   if (slot.others() == kNoOthers) {
-    if (others_used_ == others_.size()) others_.emplace_back();
-    slot.tag = slotTag(stamp_, static_cast<std::uint32_t>(others_used_++));
-    others_[slot.others()].clear();
+    slot.tag = slotTag(stamp_, static_cast<std::uint32_t>(others_.size()));
+    others_.push_back({allocate(kFirstCapacity), 0, kFirstCapacity});
   }
   // The inline interval, which may have grown over some of the others (Writer::addFree grows it
   // without looking at them), goes among them; the volume comes inline with what it reaches.
   OtherIntervals& others = others_[slot.others()];
+  if (others.size == others.capacity) moveToLargerRoom(others);
+  const std::size_t first = others.offset;
+  const std::size_t end = first + others.size;
   ScanInterval current{slot.bottom, slot.top, count_masses_ ? tile.masses[local] : 0.0};
   const ScanInterval added{volume.bottom, volume.top,
                            count_masses_ ? static_cast<double>(volume.mass) : 0.0};
   ScanInterval joined = added;
-  const auto [current_first, current_last] =
-      joinReached(others.begin(), others.end(), current, join_gap_);
-  const auto [taken, taken_last] = joinReached(others.begin(), others.end(), joined, join_gap_);
+  const auto [current_first, current_last] = joinReached(first, end, current);
+  const auto [taken, taken_last] = joinReached(first, end, joined);
   if (current_first == current_last && taken_last - taken <= 1) {
     // The commonest case (a lidar's next beam): the inline interval reaches none of the others
     // and the volume reaches one at most. The inline interval is inserted among them, or
     // replaces the one reached, those between the two places shifted by one to keep their order
     // (the volume never reaches the inline interval here).
-    const auto place = current_first;  // where the inline interval belongs among the others
+    const std::size_t place = current_first;  // where the inline interval belongs
     if (taken == taken_last) {
-      others.insert(place, current);
+      replaceRange(others, place, place, current);
     } else if (place <= taken) {
-      std::move_backward(place, taken, taken + 1);
-      *place = current;
+      moveIntervals(place, taken - place, place + 1);
+      setInterval(place, current);
     } else {
-      std::move(taken + 1, place, taken);
-      *(place - 1) = current;
+      moveIntervals(taken + 1, place - taken - 1, taken);
+      setInterval(place - 1, current);
     }
   } else {
-    others.insert(others.erase(current_first, current_last), current);
+    replaceRange(others, current_first, current_last, current);
     joined = added;
-    takeReached(others, joined, join_gap_);
+    const std::size_t new_end = first + others.size;
+    const auto [reached, reached_last] = joinReached(first, new_end, joined);
+    moveIntervals(reached_last, new_end - reached_last, reached);
+    others.size -= static_cast<std::uint32_t>(reached_last - reached);
   }
   slot.bottom = joined.bottom;
   slot.top = joined.top;
@@ -182,11 +196,12 @@ void ScanScratch::appendFree(const ScratchTile& tile, unsigned local,
   }
   // The inline interval joined with the others it grew over (see addFreeSlow), in their order.
   const OtherIntervals& others = others_[slot.others()];
+  const std::size_t end = others.offset + others.size;
   ScanInterval joined = current;
-  const auto [first, last] = joinReached(others.begin(), others.end(), joined, join_gap_);
-  out.insert(out.end(), others.begin(), first);
+  const auto [first, last] = joinReached(others.offset, end, joined);
+  for (std::size_t k = others.offset; k < first; ++k) out.push_back(intervalAt(k));
   out.push_back(joined);
-  out.insert(out.end(), last, others.end());
+  for (std::size_t k = last; k < end; ++k) out.push_back(intervalAt(k));
 }
 
 namespace {

@@ -813,6 +813,39 @@ TEST(Insertion, LevelAndShallowRaysEqualThePlainReference) {
   }
 }
 
+TEST(Insertion, ColumnsCrossedAtManyHeightsEqualThePlainReference) {
+  // A rotating lidar's beams, 2 degrees apart, cross a column far from the sensor at as many
+  // heights, too far apart to join: one scan gives such a column dozens of free intervals, which
+  // the scan's scratch keeps in runs of one arena that grow (8, 16, 32, 64 intervals) and move,
+  // their old room reused by other columns' runs. Here a fan of 41 beams in a vertical plane, at
+  // five azimuths, hits and readings without a return, in a shuffled order (a beam meets a column
+  // below, above or between the intervals it holds), from three origins: the map must equal
+  // test::ReferenceModel's under every rule set (masses counted per scan and per reading).
+  std::mt19937 rng(8);
+  for (const ModelRules& rules : everyRuleSet()) {
+    SCOPED_TRACE(describe(rules));
+    test::MapBesideReference maps(MapConfig{0.25, 10000.0, rules});
+    for (int k = 0; k < 3; ++k) {
+      Scan scan;
+      scan.origin = {0.1 * k, -0.05 * k, 1.0 + 0.2 * k};
+      std::uniform_real_distribution<double> range(6.0, 8.0);
+      for (int azimuth = 0; azimuth < 5; ++azimuth) {
+        const double angle = 0.02 * azimuth + 0.3 * k;
+        for (int beam = -20; beam <= 20; ++beam) {
+          const double distance = range(rng);
+          const Eigen::Vector3d end =
+              scan.origin +
+              distance * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.15 * beam);
+          (beam % 6 == 0 ? scan.out_of_range : scan.hits).push_back(end.cast<float>());
+        }
+      }
+      std::shuffle(scan.hits.begin(), scan.hits.end(), rng);
+      ASSERT_TRUE(maps.insert(scan)) << "scan " << k;
+    }
+    EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
+  }
+}
+
 TEST(Insertion, ThreadsBuildTheSameMapFromLevelScans) {
   // A level scan's threads keep one bit a cell for its one free volume (its readings at its
   // origin's height, in float as in double: 0.375 m). A scan with a few rising rays in one
