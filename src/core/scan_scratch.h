@@ -249,13 +249,15 @@ class ScanScratch {
     float bottom;
     float top;
   };
-  /// A column's first other intervals get a cache line's room (most hold a few).
+  /// A column's first other intervals get 64 bytes of room (most hold a few).
   static constexpr std::uint32_t kFirstCapacity = 64 / sizeof(Heights);
   /// Room in the arena for `capacity` intervals (kFirstCapacity times a power of two): its
   /// offset.
   std::size_t allocate(std::uint32_t capacity);
-  /// Moves `others`, which is full, to room twice as large; the room it leaves goes to a run
-  /// that grows later.
+  /// k for a capacity of kFirstCapacity << k: the list of free_runs_ its room goes to.
+  static std::size_t sizeClass(std::uint32_t capacity);
+  /// Moves `others`, which is full, to room twice as large; the room it leaves goes to the next
+  /// run needing room of that size (allocate).
   void moveToLargerRoom(OtherIntervals& others);
   ScanInterval intervalAt(std::size_t index) const {
     return {heights_[index].bottom, heights_[index].top, count_masses_ ? masses_[index] : 0.0};

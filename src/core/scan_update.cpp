@@ -3,9 +3,9 @@
 #include "mvog/scan_update.h"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <iterator>
 #include <limits>
 #include <utility>
@@ -75,21 +75,28 @@ ScratchTile& ScanScratch::findOrAddTile(std::int32_t tile_x, std::int32_t tile_y
   return **slot;
 }
 
+std::size_t ScanScratch::sizeClass(std::uint32_t capacity) {
+  const std::uint32_t rooms = capacity / kFirstCapacity;
+  assert(rooms != 0 && capacity % kFirstCapacity == 0 && (rooms & (rooms - 1)) == 0);
+  return lowestBit(rooms);
+}
+
 std::size_t ScanScratch::allocate(std::uint32_t capacity) {
   // Room that a run left when it moved (moveToLargerRoom) is reused first.
-  const auto size_class = static_cast<std::size_t>(lowestBit(capacity / kFirstCapacity));
+  const std::size_t size_class = sizeClass(capacity);
   if (size_class < free_runs_.size() && !free_runs_[size_class].empty()) {
     const std::size_t offset = free_runs_[size_class].back();
     free_runs_[size_class].pop_back();
     return offset;
   }
   const std::size_t offset = arena_used_;
-  arena_used_ += capacity;
-  if (arena_used_ > arena_capacity_) {
-    const std::size_t grown = std::max(arena_used_, 2 * arena_capacity_);
+  const std::size_t used = arena_used_ + capacity;
+  if (used > arena_capacity_) {
+    const std::size_t grown = std::max(used, 2 * arena_capacity_);
     std::unique_ptr<Heights[]> heights(new Heights[grown]);
     std::unique_ptr<double[]> masses(new double[grown]);
-    // Copied as bytes: the room of a run beyond its size was never written.
+    // The whole used part is copied, the room of runs beyond their size and the room runs left
+    // included (never read before it is written again).
     if (offset > 0) std::memcpy(heights.get(), heights_.get(), offset * sizeof(Heights));
     if (offset > 0 && count_masses_)
       std::memcpy(masses.get(), masses_.get(), offset * sizeof(double));
@@ -97,13 +104,17 @@ std::size_t ScanScratch::allocate(std::uint32_t capacity) {
     masses_ = std::move(masses);
     arena_capacity_ = grown;
   }
+  arena_used_ = used;  // only once the room exists: an allocation that throws leaves it as it was
   return offset;
 }
 
 void ScanScratch::moveToLargerRoom(OtherIntervals& others) {
+  // A column holds at most one interval a reading: a run's capacity reaches 2^31 only in a scan
+  // of over 2^30 readings (12 GB of points), where doubling it would wrap.
+  assert(others.capacity <= std::numeric_limits<std::uint32_t>::max() / 2);
   const std::size_t offset = allocate(2 * others.capacity);
   moveIntervals(others.offset, others.size, offset);
-  const auto size_class = static_cast<std::size_t>(lowestBit(others.capacity / kFirstCapacity));
+  const std::size_t size_class = sizeClass(others.capacity);
   if (size_class >= free_runs_.size()) free_runs_.resize(size_class + 1);
   free_runs_[size_class].push_back(others.offset);
   others.offset = offset;

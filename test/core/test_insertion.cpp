@@ -814,13 +814,14 @@ TEST(Insertion, LevelAndShallowRaysEqualThePlainReference) {
 }
 
 TEST(Insertion, ColumnsCrossedAtManyHeightsEqualThePlainReference) {
-  // A rotating lidar's beams, 2 degrees apart, cross a column far from the sensor at as many
-  // heights, too far apart to join: one scan gives such a column dozens of free intervals, which
-  // the scan's scratch keeps in runs of one arena that grow (8, 16, 32, 64 intervals) and move,
-  // their old room reused by other columns' runs. Here a fan of 41 beams in a vertical plane, at
-  // five azimuths, hits and readings without a return, in a shuffled order (a beam meets a column
-  // below, above or between the intervals it holds), from three origins: the map must equal
-  // test::ReferenceModel's under every rule set (masses counted per scan and per reading).
+  // A rotating lidar's beams cross a column far from the sensor at as many heights, too far apart
+  // to join: one scan gives such a column dozens of free intervals, which the scan's scratch
+  // keeps in runs of one arena that grow (8, 16, 32, 64 intervals) and move, their old room
+  // reused by other columns' runs. Here a fan of 41 beams in a vertical plane (each rising 0.15 m
+  // a metre more than the one below), at five azimuths, hits and readings without a return, in a
+  // shuffled order (a beam meets a column below, above or between the intervals it holds), from
+  // three origins: the map must equal test::ReferenceModel's under every rule set (masses
+  // counted per scan and per reading).
   std::mt19937 rng(8);
   for (const ModelRules& rules : everyRuleSet()) {
     SCOPED_TRACE(describe(rules));
