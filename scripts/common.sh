@@ -36,11 +36,13 @@ quietly() {
   local name=$1
   shift
   mkdir -p "$LOG_DIR"
-  if ! "$@" >"$LOG_DIR/$name.log" 2>&1; then
+  local status=0
+  "$@" >"$LOG_DIR/$name.log" 2>&1 || status=$?
+  if [ "$status" -ne 0 ]; then
     echo "FAILED: $* (log: $LOG_DIR/$name.log)" >&2
     tail -n 60 "$LOG_DIR/$name.log" >&2
-    return 1
   fi
+  return "$status"
 }
 
 install_missing_packages() {

@@ -23,6 +23,14 @@ failed=0
 skipped=0
 failures=()
 
+# The catkin tests and the sanitizer stage (some 5 and 11-15 minutes on a 2-core machine) run
+# under `timeout` with three to five times that: a test that hangs fails its stage, saying so,
+# well before CI's own limit of 90 minutes would stop the whole run.
+catkin_tests_limit=1500
+sanitizers_limit=2700
+# timed_out STATUS: whether STATUS is that of a command `timeout --kill-after` stopped.
+timed_out() { [ "$1" -eq 124 ] || [ "$1" -eq 137 ]; }
+
 # 0. Every C++ file is formatted with the repository's .clang-format.
 unformatted=()
 while IFS= read -r -d '' file; do
@@ -54,7 +62,13 @@ source_workspace
 stage "catkin build"
 
 rm -rf "$WORKSPACE/build/test_results"
-quietly run-tests bash -c "cd '$WORKSPACE' && catkin_make run_tests -j2" || true
+run_tests_status=0
+quietly run-tests timeout --kill-after=30 "$catkin_tests_limit" \
+  bash -c "cd '$WORKSPACE' && catkin_make run_tests -j2" || run_tests_status=$?
+if timed_out "$run_tests_status"; then
+  failed=$((failed + 1))
+  failures+=("catkin tests: stopped after $catkin_tests_limit s (log: $LOG_DIR/run-tests.log)")
+fi
 results=$(catkin_test_results --all "$WORKSPACE/build/test_results" 2>&1 || true)
 echo "$results" >"$LOG_DIR/catkin-test-results.log"
 summary=$(grep -E '^Summary:' <<<"$results" || echo "Summary: 0 tests, 1 errors, 0 failures, 0 skipped")
@@ -90,7 +104,12 @@ count_script lint
 stage linters
 
 # 4. Sanitizer builds and fuzzing: ASan + UBSan, TSan, libFuzzer.
-bash "$REPO/scripts/sanitizers.sh" >"$LOG_DIR/sanitizers.log" 2>&1 || true
+sanitizers_status=0
+timeout --kill-after=30 "$sanitizers_limit" bash "$REPO/scripts/sanitizers.sh" \
+  >"$LOG_DIR/sanitizers.log" 2>&1 || sanitizers_status=$?
+if timed_out "$sanitizers_status"; then  # counted by count_script: no summary line
+  echo "FAILED: stopped after $sanitizers_limit s" >>"$LOG_DIR/sanitizers.log"
+fi
 count_script sanitizers
 stage sanitizers
 
