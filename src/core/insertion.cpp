@@ -351,7 +351,7 @@ bool mergeWithoutContact(const detail::ColumnRef& existing, const CellVolumes& a
 /// into the cell's lists `existing`, in place where their lengths stay, else into the tile's
 /// rewrite. Out of line: the loop over a tile's cells then keeps the commonest case's values in
 /// registers.
-[[gnu::noinline]] void updateColumn(unsigned local, HitRun hits, const detail::ColumnRef& existing,
+[[gnu::noinline]] void updateColumn(unsigned local, HitRun hits, detail::ColumnRef existing,
                                     const ModelRules& rules, float unit_mass, CellIndex origin,
                                     ColumnWork& work) {
   Volume* stored = const_cast<Volume*>(existing.positive);
@@ -393,10 +393,8 @@ bool mergeWithoutContact(const detail::ColumnRef& existing, const CellVolumes& a
     return;
   }
   work.rewrite.set(local, work.merged.positive, work.merged.negative);
-  if (existing.empty() && num_positive + num_negative > 0) {
-    work.grown.extend(CellIndex{origin.x + static_cast<std::int32_t>(local % detail::kTileSize),
-                                origin.y + static_cast<std::int32_t>(local / detail::kTileSize)});
-  }
+  if (existing.empty() && num_positive + num_negative > 0)
+    work.grown.extend(detail::cellInTile(origin, local));
 }
 
 /// Merges the new volumes of the scan's scratches into the columns of tile `key`.
@@ -414,18 +412,25 @@ MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
   HitCursor hit_cursor(work.hits);
   // With one thread's part, a cell's free space may be one interval read from it directly.
   const auto* only_part = work.parts.size() == 1 ? &work.parts[0] : nullptr;
+  const detail::TileBlock::Layout layout(tile);
   for (std::size_t word = 0; word < std::size(work.reached); ++word) {
     for (std::uint64_t bits = work.reached[word]; bits != 0; bits &= bits - 1) {
       const auto local = static_cast<unsigned>(64 * word + detail::lowestBit(bits));
       const HitRun hits = hit_cursor.next(local);
-      const detail::ColumnRef existing = tile.column(local);
+      const detail::ColumnRef existing = layout.column(local);
       ScanInterval single;
-      if (hits.empty() && !existing.empty() && only_part != nullptr &&
+      if (hits.empty() && only_part != nullptr &&
           only_part->first->singleFree(*only_part->second, local, single)) {
-        // The commonest case without a vector in between: one free interval, no hit, changed
-        // in the tile's own storage.
+        // The commonest cases without a vector in between: one free interval, no hit, changed
+        // in the tile's own storage, or a cell's first volume.
         const Volume added{single.bottom, single.top,
                            massOf(single, single.bottom, single.top, per_scan, unit_mass)};
+        if (existing.empty()) {
+          // What the merge makes of one free volume and empty lists: that volume.
+          work.rewrite.set(local, {nullptr, 0, &added, 1});
+          work.grown.extend(detail::cellInTile(origin, local));
+          continue;
+        }
         Volume* negative = const_cast<Volume*>(existing.negative);
         if (addCoveredFreeSpace(VolumeRun(&added, 1), negative, existing.num_negative)) {
           continue;

@@ -323,13 +323,12 @@ std::size_t Map::clearBox(const Eigen::Vector3d& min_corner, const Eigen::Vector
       ++it;
       continue;
     }
-    const EditCount count = editColumns(
-        it->second, revision, work,
-        [&](unsigned local, const detail::ColumnRef& column, ColumnEdit& edit) {
-          const CellIndex cell{tile_cells.min.x + static_cast<std::int32_t>(local % kTileSize),
-                               tile_cells.min.y + static_cast<std::int32_t>(local / kTileSize)};
-          return cells.contains(cell) && cutColumn(column, low, high, edit);
-        });
+    const EditCount count =
+        editColumns(it->second, revision, work,
+                    [&](unsigned local, const detail::ColumnRef& column, ColumnEdit& edit) {
+                      return cells.contains(detail::cellInTile(tile_cells.min, local)) &&
+                             cutColumn(column, low, high, edit);
+                    });
     cells_changed += count.cells_changed;
     emptied |= count.cells_emptied > 0;
     it = it->second.empty() ? storage_->removeTile(it, revision) : std::next(it);

@@ -244,8 +244,7 @@ void Map::setCellVolumes(const std::vector<CellAssignment>& cells) {
         stored(v.negative, negative);
         merger.cutAsTheMergeDoes(negative, positive, free_space_rules);
         builder.add(local, positive, negative);
-        bounds_.extend(CellIndex{origin.x + static_cast<std::int32_t>(local % kTileSize),
-                                 origin.y + static_cast<std::int32_t>(local / kTileSize)});
+        bounds_.extend(detail::cellInTile(origin, local));
       } else if (old != nullptr && old->holds(local)) {
         builder.add(local, old->column(local), rescale);
       }

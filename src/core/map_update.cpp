@@ -250,10 +250,8 @@ std::vector<std::uint8_t> MapUpdateCodec::encode(const Map& map, std::uint64_t s
     for (unsigned local = 0; local < kCellsPerTile; ++local) {
       if (!tile.holds(local)) continue;
       const ColumnRef column = tile.column(local);
-      writeCell(writer,
-                {origin.x + static_cast<std::int32_t>(local % kTileSize),
-                 origin.y + static_cast<std::int32_t>(local / kTileSize)},
-                column.positive, column.num_positive, column.negative, column.num_negative);
+      writeCell(writer, cellInTile(origin, local), column.positive, column.num_positive,
+                column.negative, column.num_negative);
     }
   }
   writer.checksum();

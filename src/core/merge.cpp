@@ -107,8 +107,7 @@ void Map::merge(const Map& other, const GridTransform& this_from_other) {
     const CellIndex origin = detail::tileOrigin(entry.first);
     for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
       if (!tile.holds(local)) continue;
-      const CellIndex cell{origin.x + static_cast<std::int32_t>(local % kTileSize),
-                           origin.y + static_cast<std::int32_t>(local / kTileSize)};
+      const CellIndex cell = detail::cellInTile(origin, local);
       const auto [x, y] = this_from_other.target(cell);
       if (std::fabs(static_cast<double>(x)) > max_cell ||
           std::fabs(static_cast<double>(y)) > max_cell) {

@@ -165,8 +165,7 @@ void Map::forEachVolumeIn(
     if (!tile_cells.intersects(cells)) continue;
     const detail::TileBlock& tile = storage_->tiles.at(key);
     for (unsigned local = 0; local < detail::kCellsPerTile; ++local) {
-      const CellIndex index{tile_cells.min.x + static_cast<std::int32_t>(local % kTileSize),
-                            tile_cells.min.y + static_cast<std::int32_t>(local / kTileSize)};
+      const CellIndex index = detail::cellInTile(tile_cells.min, local);
       if (!tile.holds(local) || !cells.contains(index)) continue;
       const detail::ColumnRef column = tile.column(local);
       auto visit_list = [&](VolumeSign sign, const Volume* list, std::uint32_t count) {

@@ -49,6 +49,17 @@ std::size_t TileBlock::bytes() const {
   return block_->volumes_offset + std::size_t{block_->num_volumes} * sizeof(Volume);
 }
 
+TileBlock::Layout::Layout(const TileBlock& tile) {
+  if (tile.empty()) return;
+  const Header& header = *tile.block_;
+  std::copy(std::begin(header.occupied), std::end(header.occupied), occupied_);
+  std::copy(std::begin(header.words_before), std::end(header.words_before), words_before_ + 1);
+  starts_ = tile.starts();
+  positive_counts_ = tile.positiveCounts();
+  volumes_ = tile.volumes();
+  wide_ = header.wide != 0;
+}
+
 Volume* TileBlock::mutableVolumes(unsigned local) {
   return const_cast<Volume*>(volumes()) + start(rank(local));
 }
@@ -212,13 +223,11 @@ void TileBlock::Rewrite::clear() {
   volumes_.clear();
 }
 
-void TileBlock::Rewrite::set(unsigned local, const std::vector<Volume>& positive,
-                             const std::vector<Volume>& negative) {
+void TileBlock::Rewrite::set(unsigned local, const ColumnRef& lists) {
   assert(cells_.empty() || cells_.back().local < local);  // apply() copies the cells between
-  cells_.push_back({local, volumes_.size(), static_cast<std::uint32_t>(positive.size()),
-                    static_cast<std::uint32_t>(negative.size())});
-  volumes_.insert(volumes_.end(), positive.begin(), positive.end());
-  volumes_.insert(volumes_.end(), negative.begin(), negative.end());
+  cells_.push_back({local, volumes_.size(), lists.num_positive, lists.num_negative});
+  volumes_.insert(volumes_.end(), lists.positive, lists.positive + lists.num_positive);
+  volumes_.insert(volumes_.end(), lists.negative, lists.negative + lists.num_negative);
 }
 
 TileBlock TileBlock::Rewrite::apply(const TileBlock& tile, std::int32_t exponent,

@@ -46,6 +46,13 @@ inline unsigned localIndex(const CellIndex& c) {
   return static_cast<unsigned>((c.y & kMask) * kTileSize + (c.x & kMask));
 }
 
+/// The cell of local index `local` in the tile whose first cell is `origin` (localIndex's
+/// inverse).
+inline CellIndex cellInTile(const CellIndex& origin, unsigned local) {
+  return {origin.x + static_cast<std::int32_t>(local % kTileSize),
+          origin.y + static_cast<std::int32_t>(local / kTileSize)};
+}
+
 /// The index of the lowest set bit of bits != 0 (bsf: on every x86-64, unlike popcnt).
 inline unsigned lowestBit(std::uint64_t bits) {
   return static_cast<unsigned>(__builtin_ctzll(bits));
@@ -106,6 +113,27 @@ class TileBlock {
   /// Where the volumes of cell `local` (which holds some) are stored: to change them in place,
   /// keeping their number.
   Volume* mutableVolumes(unsigned local);
+
+  /// A tile's layout (its bitmap, entries and volumes), read from its header once: for a loop
+  /// that finds the lists of many of its cells (Map::apply's update of a tile), whose values then
+  /// stay in registers instead of being read from the header at each cell, and again past each
+  /// call. Valid while the tile's block is and no cell's lists change length (their volumes may
+  /// change in place).
+  class Layout {
+   public:
+    explicit Layout(const TileBlock& tile);
+    /// TileBlock::column.
+    ColumnRef column(unsigned local) const;
+
+   private:
+    std::uint64_t occupied_[kCellsPerTile / 64] = {};  // all clear for an empty tile
+    unsigned words_before_[kCellsPerTile / 64] = {};   // cells holding volumes before word k
+    const unsigned char* starts_ = nullptr;
+    const unsigned char* positive_counts_ = nullptr;
+    const Volume* volumes_ = nullptr;
+    bool wide_ = false;
+  };
+
   bool holds(unsigned local) const {
     return block_ != nullptr && ((block_->occupied[local >> 6] >> (local & 63)) & 1u) != 0;
   }
@@ -169,8 +197,12 @@ class TileBlock {
    public:
     void clear();
     /// The new lists of cell `local` (both empty: the cell goes), in increasing local index.
+    void set(unsigned local, const ColumnRef& lists);
     void set(unsigned local, const std::vector<Volume>& positive,
-             const std::vector<Volume>& negative);
+             const std::vector<Volume>& negative) {
+      set(local, {positive.data(), static_cast<std::uint32_t>(positive.size()), negative.data(),
+                  static_cast<std::uint32_t>(negative.size())});
+    }
     bool empty() const { return cells_.empty(); }
     /// `tile` with the cells set replaced (empty if no cell is left).
     TileBlock apply(const TileBlock& tile, std::int32_t exponent, std::uint64_t modified_revision);
@@ -215,6 +247,17 @@ class TileBlock {
   std::uint32_t start(unsigned rank) const;
   std::uint32_t positiveCount(unsigned rank) const;
   const Volume* volumes() const;
+  /// The entries: starts (num_cells + 1, 16 or 32 bits), then positive counts (8 or 32 bits).
+  const unsigned char* starts() const;
+  const unsigned char* positiveCounts() const;
+  // The layout's reads, on values read from the header: by the members above at each call, by
+  // Layout once.
+  static unsigned rankIn(std::uint64_t word, unsigned words_before, unsigned local);
+  static std::uint32_t startAt(const unsigned char* starts, bool wide, unsigned rank);
+  static std::uint32_t positiveCountAt(const unsigned char* positive_counts, bool wide,
+                                       unsigned rank);
+  static ColumnRef columnIn(const Volume* volumes, const unsigned char* starts,
+                            const unsigned char* positive_counts, bool wide, unsigned rank);
   static std::size_t volumesOffset(std::uint32_t num_cells, bool wide);
   /// A tile of `num_cells` cells and `num_volumes` volumes, its header written with an empty
   /// bitmap: the caller sets the bitmap, then calls countWordsBefore, and writes the entries and
@@ -238,34 +281,60 @@ inline unsigned bitCount(std::uint64_t x) {
   return static_cast<unsigned>((x * 0x0101010101010101ull) >> 56);
 }
 
-inline unsigned TileBlock::rank(unsigned local) const {
-  const unsigned word = local >> 6;
-  const std::uint64_t below = (std::uint64_t{1} << (local & 63)) - 1;
-  return (word == 0 ? 0u : block_->words_before[word - 1]) +
-         bitCount(block_->occupied[word] & below);
+inline unsigned TileBlock::rankIn(std::uint64_t word, unsigned words_before, unsigned local) {
+  return words_before + bitCount(word & ((std::uint64_t{1} << (local & 63)) - 1));
 }
 
-inline std::uint32_t TileBlock::start(unsigned rank) const {
-  const auto* base = reinterpret_cast<const unsigned char*>(block_ + 1);
-  if (block_->wide != 0) {
+inline std::uint32_t TileBlock::startAt(const unsigned char* starts, bool wide, unsigned rank) {
+  if (wide) {
     std::uint32_t value;
-    std::memcpy(&value, base + 4 * std::size_t{rank}, 4);
+    std::memcpy(&value, starts + 4 * std::size_t{rank}, 4);
     return value;
   }
   std::uint16_t value;
-  std::memcpy(&value, base + 2 * std::size_t{rank}, 2);
+  std::memcpy(&value, starts + 2 * std::size_t{rank}, 2);
   return value;
 }
 
-inline std::uint32_t TileBlock::positiveCount(unsigned rank) const {
-  const std::uint32_t n = block_->num_cells;
-  const auto* base = reinterpret_cast<const unsigned char*>(block_ + 1);
-  if (block_->wide != 0) {
+inline std::uint32_t TileBlock::positiveCountAt(const unsigned char* positive_counts, bool wide,
+                                                unsigned rank) {
+  if (wide) {
     std::uint32_t value;
-    std::memcpy(&value, base + 4 * (std::size_t{n} + 1 + rank), 4);
+    std::memcpy(&value, positive_counts + 4 * std::size_t{rank}, 4);
     return value;
   }
-  return base[2 * (std::size_t{n} + 1) + rank];
+  return positive_counts[rank];
+}
+
+inline ColumnRef TileBlock::columnIn(const Volume* volumes, const unsigned char* starts,
+                                     const unsigned char* positive_counts, bool wide,
+                                     unsigned rank) {
+  const std::uint32_t first = startAt(starts, wide, rank);
+  const std::uint32_t end = startAt(starts, wide, rank + 1);
+  const std::uint32_t num_positive = positiveCountAt(positive_counts, wide, rank);
+  const Volume* list = volumes + first;
+  return {list, num_positive, list + num_positive, end - first - num_positive};
+}
+
+inline const unsigned char* TileBlock::starts() const {
+  return reinterpret_cast<const unsigned char*>(block_ + 1);
+}
+
+inline const unsigned char* TileBlock::positiveCounts() const {
+  return starts() + (block_->wide != 0 ? 4 : 2) * (std::size_t{block_->num_cells} + 1);
+}
+
+inline unsigned TileBlock::rank(unsigned local) const {
+  const unsigned word = local >> 6;
+  return rankIn(block_->occupied[word], word == 0 ? 0u : block_->words_before[word - 1], local);
+}
+
+inline std::uint32_t TileBlock::start(unsigned rank) const {
+  return startAt(starts(), block_->wide != 0, rank);
+}
+
+inline std::uint32_t TileBlock::positiveCount(unsigned rank) const {
+  return positiveCountAt(positiveCounts(), block_->wide != 0, rank);
 }
 
 inline const Volume* TileBlock::volumes() const {
@@ -279,11 +348,14 @@ inline ColumnRef TileBlock::column(unsigned local) const {
 }
 
 inline ColumnRef TileBlock::columnAtRank(unsigned r) const {
-  const std::uint32_t first = start(r);
-  const std::uint32_t end = start(r + 1);
-  const std::uint32_t num_positive = positiveCount(r);
-  const Volume* list = volumes() + first;
-  return {list, num_positive, list + num_positive, end - first - num_positive};
+  return columnIn(volumes(), starts(), positiveCounts(), block_->wide != 0, r);
+}
+
+inline ColumnRef TileBlock::Layout::column(unsigned local) const {
+  const unsigned word = local >> 6;
+  if (((occupied_[word] >> (local & 63)) & 1u) == 0) return {};
+  return columnIn(volumes_, starts_, positive_counts_, wide_,
+                  rankIn(occupied_[word], words_before_[word], local));
 }
 
 }  // namespace detail
