@@ -426,7 +426,9 @@ MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
         const Volume added{single.bottom, single.top,
                            massOf(single, single.bottom, single.top, per_scan, unit_mass)};
         if (existing.empty()) {
-          // What the merge makes of one free volume and empty lists: that volume.
+          // What the merge makes of one free volume and empty lists: that volume (a scan's free
+          // interval is at least kMinVolumeHeight high, so no rule cuts it, and its mass, a sum
+          // of heights times the unit, is never -0, which the merge's 0.0 + mass would make +0).
           work.rewrite.set(local, {nullptr, 0, &added, 1});
           work.grown.extend(detail::cellInTile(origin, local));
           continue;

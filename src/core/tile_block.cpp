@@ -60,10 +60,6 @@ TileBlock::Layout::Layout(const TileBlock& tile) {
   wide_ = header.wide != 0;
 }
 
-Volume* TileBlock::mutableVolumes(unsigned local) {
-  return const_cast<Volume*>(volumes()) + start(rank(local));
-}
-
 std::uint32_t TileBlock::numPositive() const {
   std::uint32_t total = 0;
   for (std::uint32_t r = 0; r < numCells(); ++r) total += positiveCount(r);

@@ -110,15 +110,10 @@ class TileBlock {
   ColumnRef column(unsigned local) const;
   /// The lists of the cell of the given rank among those holding volumes (in local order).
   ColumnRef columnAtRank(unsigned rank) const;
-  /// Where the volumes of cell `local` (which holds some) are stored: to change them in place,
-  /// keeping their number.
-  Volume* mutableVolumes(unsigned local);
-
-  /// A tile's layout (its bitmap, entries and volumes), read from its header once: for a loop
-  /// that finds the lists of many of its cells (Map::apply's update of a tile), whose values then
-  /// stay in registers instead of being read from the header at each cell, and again past each
-  /// call. Valid while the tile's block is and no cell's lists change length (their volumes may
-  /// change in place).
+  /// A tile's layout (its bitmap, entries and volumes), copied from its header once: for a loop
+  /// that finds the lists of many of its cells (Map::apply's update of a tile), instead of reading
+  /// them through the tile's block at each cell, and again past each call. Valid while the tile's
+  /// block is and no cell's lists change length (their volumes may change in place).
   class Layout {
    public:
     explicit Layout(const TileBlock& tile);
@@ -242,7 +237,8 @@ class TileBlock {
   };
   static_assert(sizeof(Header) == 64, "the header fills one cache line");
   static constexpr float kUnknownMass = std::numeric_limits<float>::quiet_NaN();
-  /// Rank of cell `local` among the cells with volumes (its bit must be set).
+  /// The number of cells holding volumes before cell `local` (its rank among them if it holds
+  /// some).
   unsigned rank(unsigned local) const;
   std::uint32_t start(unsigned rank) const;
   std::uint32_t positiveCount(unsigned rank) const;
