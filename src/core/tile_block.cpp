@@ -222,8 +222,9 @@ void TileBlock::Rewrite::clear() {
 void TileBlock::Rewrite::set(unsigned local, const ColumnRef& lists) {
   assert(cells_.empty() || cells_.back().local < local);  // apply() copies the cells between
   cells_.push_back({local, volumes_.size(), lists.num_positive, lists.num_negative});
-  volumes_.insert(volumes_.end(), lists.positive, lists.positive + lists.num_positive);
-  volumes_.insert(volumes_.end(), lists.negative, lists.negative + lists.num_negative);
+  // Volume by volume: a cell's lists are short (a range insert costs more for one volume).
+  for (std::uint32_t k = 0; k < lists.num_positive; ++k) volumes_.push_back(lists.positive[k]);
+  for (std::uint32_t k = 0; k < lists.num_negative; ++k) volumes_.push_back(lists.negative[k]);
 }
 
 TileBlock TileBlock::Rewrite::apply(const TileBlock& tile, std::int32_t exponent,
@@ -280,16 +281,20 @@ TileBlock TileBlock::Rewrite::applyNarrow(const TileBlock& tile, std::int32_t ex
     const auto value = static_cast<std::uint16_t>(start);
     std::memcpy(starts + 2 * std::size_t{at}, &value, 2);
   };
-  // The old cells of ranks [first_rank, end_rank), unchanged: their volumes are one run.
+  // The old cells of ranks [first_rank, end_rank), unchanged: their volumes are one run, their
+  // starts all move by one offset and their positive counts stay (both narrow here).
+  const unsigned char* old_starts = tile.empty() ? nullptr : tile.starts();
+  const unsigned char* old_counts = tile.empty() ? nullptr : tile.positiveCounts();
   auto copy_unchanged = [&](unsigned first_rank, unsigned end_rank) {
     if (first_rank == end_rank) return;
-    const std::uint32_t first = tile.start(first_rank);
-    const std::uint32_t count = tile.start(end_rank) - first;
+    const std::uint32_t first = startAt(old_starts, false, first_rank);
+    const std::uint32_t count = startAt(old_starts, false, end_rank) - first;
     std::memcpy(volumes + written, tile.volumes() + first, std::size_t{count} * sizeof(Volume));
     for (unsigned r = first_rank; r < end_rank; ++r) {
-      write_start(rank, tile.start(r) - first + written);
-      counts[rank++] = static_cast<unsigned char>(tile.positiveCount(r));
+      write_start(rank + (r - first_rank), startAt(old_starts, false, r) - first + written);
     }
+    std::memcpy(counts + rank, old_counts + first_rank, end_rank - first_rank);
+    rank += end_rank - first_rank;
     written += count;
   };
   unsigned old_rank = 0;  // the next old cell not yet passed
