@@ -100,7 +100,8 @@ void gatherTile(std::uint64_t key, const std::vector<detail::ScanScratch>& scrat
   work.hits.clear();
   std::fill(std::begin(work.reached), std::end(work.reached), std::uint64_t{0});
   for (const detail::ScanScratch& scratch : scratches) {
-    if (const detail::ScratchTile* part = scratch.find(key)) {
+    const detail::ScratchTile* part = scratch.find(key);
+    if (part != nullptr && !part->reachedNone()) {
       work.parts.emplace_back(&scratch, part);
       work.hits.insert(work.hits.end(), part->hits.begin(), part->hits.end());
       for (std::size_t w = 0; w < std::size(work.reached); ++w) {
@@ -472,7 +473,9 @@ InsertionResult Map::apply(ScanUpdate& update) {
   }
   std::vector<std::uint64_t> keys;
   for (const detail::ScanScratch& scratch : impl.scratches) {
-    for (const auto& entry : scratch.tiles()) keys.push_back(entry.first);
+    for (const auto& [key, tile] : scratch.tiles()) {
+      if (!tile->reachedNone()) keys.push_back(key);
+    }
   }
   if (keys.empty()) return impl.result;
   std::sort(keys.begin(), keys.end());

@@ -90,6 +90,13 @@ struct ScratchTile {
   bool levelFree(unsigned local) const {
     return ((level_free[local >> 6] >> (local & 63)) & 1u) != 0;
   }
+  /// Whether no cell got anything (a tile the walk only touched at a corner, Writer::enterTile);
+  /// a cell with a hit is reached.
+  bool reachedNone() const {
+    std::uint64_t any = 0;
+    for (std::size_t w = 0; w < kCellsPerTile / 64; ++w) any |= reached[w] | level_free[w];
+    return any == 0;
+  }
 };
 
 /// Whether two intervals, one not below the other, join: the upper one's bottom is at most
@@ -133,14 +140,14 @@ class ScanScratch {
       tile_y_ = cell.y >> kTileSizeLog2;
       local_x_ = cell.x & (kTileSize - 1);
       local_y_ = cell.y & (kTileSize - 1);
-      tile_ = nullptr;
+      enterTile();
     }
     void stepX(int step) {
       local_x_ += step;
       if (static_cast<unsigned>(local_x_) >= kTileSize) {  // into the next tile along x
         local_x_ -= step * kTileSize;
         tile_x_ += step;
-        tile_ = nullptr;
+        enterTile();
       }
     }
     void stepY(int step) {
@@ -148,14 +155,14 @@ class ScanScratch {
       if (static_cast<unsigned>(local_y_) >= kTileSize) {
         local_y_ -= step * kTileSize;
         tile_y_ += step;
-        tile_ = nullptr;
+        enterTile();
       }
     }
 
     /// Called for every cell a ray crosses: the commonest case (the interval inline grows)
     /// stays inline in the ray walk.
     void addFree(const Volume& volume) {
-      ScratchTile& tile = currentTile();
+      ScratchTile& tile = *tile_;
       const unsigned local = currentLocal();
       if constexpr (kLevel) {  // every free volume of the scan is the level one
         static_assert(!kCountMasses, "a level scan's cells hold no masses");
@@ -177,17 +184,16 @@ class ScanScratch {
       }
       scratch_.addFreeSlow(tile, local, volume);
     }
-    void addHit(const Volume& volume) { scratch_.addHit(currentTile(), currentLocal(), volume); }
+    void addHit(const Volume& volume) { scratch_.addHit(*tile_, currentLocal(), volume); }
 
    private:
-    /// The cell's tile, found when the walk first visits a cell of it (a tile whose cells the
-    /// walk only touches at a corner is not added).
-    ScratchTile& currentTile() {
-      if (tile_ == nullptr) {
-        ScratchTile* known = scratch_.denseTile(tile_x_, tile_y_);
-        tile_ = known != nullptr ? known : &scratch_.findOrAddTile(tile_x_, tile_y_);
-      }
-      return *tile_;
+    /// Finds (or adds) the tile the walk has just entered, on entering it rather than at each
+    /// visit: the test of a step into another tile is there anyway. A tile whose cells the walk
+    /// only touches at a corner is added too, with no cell reached (ScratchTile::reachedNone),
+    /// and the update passes it by.
+    void enterTile() {
+      ScratchTile* known = scratch_.denseTile(tile_x_, tile_y_);
+      tile_ = known != nullptr ? known : &scratch_.findOrAddTile(tile_x_, tile_y_);
     }
     unsigned currentLocal() const { return static_cast<unsigned>(local_y_ * kTileSize + local_x_); }
 

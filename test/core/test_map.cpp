@@ -582,6 +582,21 @@ TEST(ChangeTracking, TilesTouchedByAnInsertionAreListed) {
   EXPECT_EQ(modifiedSince(map, r2), (std::vector<std::pair<int, int>>{{-2, 4}}));
 }
 
+TEST(ChangeTracking, ATileARayOnlyTouchesAtACornerIsNotModified) {
+  // y = x passes through the corner (16, 16) where tiles (0, 0), (1, 0), (0, 1) and (1, 1) meet:
+  // the walk steps from cell (15, 15) into (16, 15), tile (1, 0), and on at once to (16, 16),
+  // crossing nothing of tile (1, 0) (WalkRay.DiagonalThroughCornersSkipsTheCornerCells).
+  Map map(unitConfig());
+  map.insertReading({20.5, 5.5, 0}, {25.5, 5.5, 0}, ReadingKind::kObstacle);  // tile (1, 0)
+  const auto before = test::allVolumes(map);
+  const std::uint64_t revision = map.revision();
+  map.insertReading({14.5, 14.5, 0}, {17.5, 17.5, 0}, ReadingKind::kObstacle);
+  EXPECT_EQ(modifiedSince(map, revision), (std::vector<std::pair<int, int>>{{0, 0}, {1, 1}}));
+  EXPECT_EQ(changedTiles(before, test::allVolumes(map)), modifiedSince(map, revision));
+  const CellVolumes corner = map.cellVolumes({16, 15});
+  EXPECT_TRUE(corner.positive.empty() && corner.negative.empty());
+}
+
 TEST(ChangeTracking, DecayIsAChangeOfNoTile) {
   // Decay changes every mass (what cellVolumes and serializeMap return), so the revision moves;
   // no probability changes, so no tile is listed. A factor of 1 changes nothing.
