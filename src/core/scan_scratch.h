@@ -90,8 +90,8 @@ struct ScratchTile {
   bool levelFree(unsigned local) const {
     return ((level_free[local >> 6] >> (local & 63)) & 1u) != 0;
   }
-  /// Whether no cell got anything (a tile the walk only touched at a corner, Writer::enterTile);
-  /// a cell with a hit is reached.
+  /// Whether no cell got anything: a tile a ray's walk stepped into without crossing any of its
+  /// cells (Writer::enterTile). A cell with a hit is reached.
   bool reachedNone() const {
     std::uint64_t any = 0;
     for (std::size_t w = 0; w < kCellsPerTile / 64; ++w) any |= reached[w] | level_free[w];
@@ -111,7 +111,7 @@ inline bool intervalsJoin(float bottom, float top, float other_bottom, float oth
   return std::max(bottom - other_top, other_bottom - top) <= join_gap;
 }
 
-/// One thread's part of a scan: the tiles its readings reached.
+/// One thread's part of a scan: the tiles its readings' walks entered.
 class ScanScratch {
  public:
   /// Forgets the previous scan (its memory is kept for the next). Intervals less than
@@ -189,8 +189,9 @@ class ScanScratch {
    private:
     /// Finds (or adds) the tile the walk has just entered, on entering it rather than at each
     /// visit: the test of a step into another tile is there anyway. A tile whose cells the walk
-    /// only touches at a corner is added too, with no cell reached (ScratchTile::reachedNone),
-    /// and the update passes it by.
+    /// does not cross (it passes a grid corner, or starts on the wall it leaves through:
+    /// walkRayWith) is added too, with no cell reached (ScratchTile::reachedNone), and the update
+    /// passes it by.
     void enterTile() {
       ScratchTile* known = scratch_.denseTile(tile_x_, tile_y_);
       tile_ = known != nullptr ? known : &scratch_.findOrAddTile(tile_x_, tile_y_);
@@ -210,7 +211,8 @@ class ScanScratch {
 
   /// The tile `key` of this scan, or nullptr.
   const ScratchTile* find(std::uint64_t key) const;
-  /// Every tile this scan reached, by key.
+  /// Every tile this scan's walks entered, by key, some perhaps with no cell reached
+  /// (ScratchTile::reachedNone).
   const std::vector<std::pair<std::uint64_t, ScratchTile*>>& tiles() const { return reached_; }
   /// Whether cell `local` of `tile` holds exactly one free interval; if so, sets it.
   bool singleFree(const ScratchTile& tile, unsigned local, ScanInterval& interval) const {
@@ -237,7 +239,7 @@ class ScanScratch {
     if (column >= dense_width_ || row >= dense_height_) return kNotDense;
     return std::size_t{row} * dense_width_ + column;
   }
-  /// The tile (tile_x, tile_y) if this scan reached it already and the dense index holds it,
+  /// The tile (tile_x, tile_y) if this scan entered it already and the dense index holds it,
   /// else null. Inline: a ray's walk enters a tile every few cells.
   ScratchTile* denseTile(std::int32_t tile_x, std::int32_t tile_y) const {
     const std::size_t index = denseIndex(tile_x, tile_y);
@@ -303,7 +305,7 @@ class ScanScratch {
     return {first, last};
   }
 
-  /// The tiles reached, by key, and the index from tile to scratch: dense over the scan's tiles
+  /// The tiles entered, by key, and the index from tile to scratch: dense over the scan's tiles
   /// when they are few enough, else hashed.
   std::vector<std::pair<std::uint64_t, ScratchTile*>> reached_;
   /// The dense index: tiles [min, min + width) x [min, min + height), rows of width entries.

@@ -582,19 +582,32 @@ TEST(ChangeTracking, TilesTouchedByAnInsertionAreListed) {
   EXPECT_EQ(modifiedSince(map, r2), (std::vector<std::pair<int, int>>{{-2, 4}}));
 }
 
-TEST(ChangeTracking, ATileARayOnlyTouchesAtACornerIsNotModified) {
+TEST(ChangeTracking, ATileARayEntersWithoutCrossingACellIsNotModified) {
   // y = x passes through the corner (16, 16) where tiles (0, 0), (1, 0), (0, 1) and (1, 1) meet:
-  // the walk steps from cell (15, 15) into (16, 15), tile (1, 0), and on at once to (16, 16),
-  // crossing nothing of tile (1, 0) (WalkRay.DiagonalThroughCornersSkipsTheCornerCells).
-  Map map(unitConfig());
-  map.insertReading({20.5, 5.5, 0}, {25.5, 5.5, 0}, ReadingKind::kObstacle);  // tile (1, 0)
-  const auto before = test::allVolumes(map);
-  const std::uint64_t revision = map.revision();
-  map.insertReading({14.5, 14.5, 0}, {17.5, 17.5, 0}, ReadingKind::kObstacle);
-  EXPECT_EQ(modifiedSince(map, revision), (std::vector<std::pair<int, int>>{{0, 0}, {1, 1}}));
-  EXPECT_EQ(changedTiles(before, test::allVolumes(map)), modifiedSince(map, revision));
-  const CellVolumes corner = map.cellVolumes({16, 15});
-  EXPECT_TRUE(corner.positive.empty() && corner.negative.empty());
+  // the walk steps from cell (15, 15) into (16, 15) or (15, 16), tile (1, 0) or (0, 1), and on
+  // at once to (16, 16), crossing nothing of the tile between
+  // (WalkRay.DiagonalThroughCornersSkipsTheCornerCells). A ray starting on x = 16 towards -x
+  // starts in cell (16, 5), tile (1, 0), on the wall it leaves through, and crosses nothing there
+  // (WalkRay.DiagonalStartingOnACorner). The paper's model and the defaults (a level scan's
+  // writer) alike.
+  for (const ModelRules& rules : {ModelRules::paper(), ModelRules{}}) {
+    SCOPED_TRACE(rules == ModelRules::paper() ? "paper model" : "default rules");
+    Map map(unitConfig(10000.0, rules));
+    map.insertReading({20.5, 5.5, 0}, {25.5, 5.5, 0}, ReadingKind::kObstacle);  // tile (1, 0)
+    map.insertReading({5.5, 20.5, 0}, {5.5, 25.5, 0}, ReadingKind::kObstacle);  // tile (0, 1)
+    const auto before = test::allVolumes(map);
+    const std::uint64_t revision = map.revision();
+    map.insertReading({14.5, 14.5, 0}, {17.5, 17.5, 0}, ReadingKind::kObstacle);
+    EXPECT_EQ(modifiedSince(map, revision), (std::vector<std::pair<int, int>>{{0, 0}, {1, 1}}));
+    EXPECT_EQ(changedTiles(before, test::allVolumes(map)), modifiedSince(map, revision));
+    for (const CellIndex& corner : {CellIndex{16, 15}, CellIndex{15, 16}}) {
+      const CellVolumes volumes = map.cellVolumes(corner);
+      EXPECT_TRUE(volumes.positive.empty() && volumes.negative.empty());
+    }
+    const std::uint64_t before_wall = map.revision();
+    map.insertReading({16.0, 5.5, 0}, {10.5, 5.5, 0}, ReadingKind::kObstacle);
+    EXPECT_EQ(modifiedSince(map, before_wall), (std::vector<std::pair<int, int>>{{0, 0}}));
+  }
 }
 
 TEST(ChangeTracking, DecayIsAChangeOfNoTile) {
