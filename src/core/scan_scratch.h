@@ -213,7 +213,7 @@ class ScanScratch {
   const ScratchTile* find(std::uint64_t key) const;
   /// Every tile this scan's walks entered, by key, some perhaps with no cell reached
   /// (ScratchTile::reachedNone).
-  const std::vector<std::pair<std::uint64_t, ScratchTile*>>& tiles() const { return reached_; }
+  const std::vector<std::pair<std::uint64_t, ScratchTile*>>& tiles() const { return entered_; }
   /// Whether cell `local` of `tile` holds exactly one free interval; if so, sets it.
   bool singleFree(const ScratchTile& tile, unsigned local, ScanInterval& interval) const {
     if (level_) {
@@ -307,7 +307,7 @@ class ScanScratch {
 
   /// The tiles entered, by key, and the index from tile to scratch: dense over the scan's tiles
   /// when they are few enough, else hashed.
-  std::vector<std::pair<std::uint64_t, ScratchTile*>> reached_;
+  std::vector<std::pair<std::uint64_t, ScratchTile*>> entered_;
   /// The dense index: tiles [min, min + width) x [min, min + height), rows of width entries.
   std::int32_t dense_min_x_ = 0;
   std::int32_t dense_min_y_ = 0;

@@ -40,7 +40,7 @@ void ScanScratch::begin(float join_gap, bool count_masses, const CellRange& tile
   count_masses_ = count_masses;
   level_ = level != nullptr && !count_masses;
   level_volume_ = level_ ? *level : Volume{};
-  reached_.clear();
+  entered_.clear();
   hashed_.clear();
   others_.clear();
   arena_used_ = 0;
@@ -63,15 +63,15 @@ ScratchTile& ScanScratch::findOrAddTile(std::int32_t tile_x, std::int32_t tile_y
   const std::size_t index = denseIndex(tile_x, tile_y);
   ScratchTile** slot = index != kNotDense ? &dense_[index] : &hashed_[tileKey(tile_x, tile_y)];
   if (*slot == nullptr) {
-    if (reached_.size() == pool_.size()) {
+    if (entered_.size() == pool_.size()) {
       pool_.push_back(std::make_unique<ScratchTile>());
       for (FreeSlot& s : pool_.back()->slots) s.tag = 0;
     }
-    *slot = pool_[reached_.size()].get();
+    *slot = pool_[entered_.size()].get();
     (*slot)->hits.clear();
     std::fill(std::begin((*slot)->reached), std::end((*slot)->reached), std::uint64_t{0});
     std::fill(std::begin((*slot)->level_free), std::end((*slot)->level_free), std::uint64_t{0});
-    reached_.emplace_back(tileKey(tile_x, tile_y), *slot);
+    entered_.emplace_back(tileKey(tile_x, tile_y), *slot);
   }
   return **slot;
 }
