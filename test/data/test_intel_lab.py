@@ -86,17 +86,7 @@ class IntelLab(data.DataTestCase):
     def test_statistics_count_every_message_and_reading(self):
         s = self.statistics
         # README: 910/910 scans transformable to map, so tf must drop none.
-        self.assertEqual(s.messages_dropped_tf, 0, "scans dropped for want of a transform (at "
-                         "-r %g the server's 10 s tf cache lasts %.2f s)" % (RATE, 10.0 / RATE))
-        self.assertEqual(s.messages_dropped_invalid, 0, "scans refused as malformed")
-        # Every scan is accounted for: inserted or dropped for a reason the statistics name.
-        self.assertEqual(s.messages_inserted + s.messages_dropped_tf + s.messages_dropped_queue
-                         + s.messages_dropped_invalid, README_SCANS,
-                         "scans lost without being counted")
-        self.assertEqual(s.messages_dropped_queue, 0,
-                         "the insertion queue dropped scans at -r %g: the replay outpaced the "
-                         "mapper" % RATE)
-        self.assertEqual(s.messages_inserted, README_SCANS)
+        self.assertEveryMessageInserted(s, README_SCANS, "scans", RATE)
         self.assertEqual(s.readings_inserted, self.expected_inserted)
         self.assertGreater(s.positive_volumes, 0)
         self.assertGreater(s.negative_volumes, 0)
