@@ -173,10 +173,31 @@ screenshot=""
 if command -v Xvfb >/dev/null && command -v rviz >/dev/null; then
   # Xvfb picks a free display itself and writes its number to the file descriptor given.
   rm -f "$LOG_DIR/demo-xvfb-display"  # the loop below must not read a previous run's number
-  Xvfb -displayfd 3 -screen 0 1280x900x24 3>"$LOG_DIR/demo-xvfb-display" >"$LOG_DIR/demo-xvfb.log" 2>&1 &
+  # The screen is the size of rviz's window (rviz/mvog.rviz, Window Geometry): the screenshot is
+  # the window alone.
+  Xvfb -displayfd 3 -screen 0 1200x800x24 3>"$LOG_DIR/demo-xvfb-display" >"$LOG_DIR/demo-xvfb.log" 2>&1 &
   BACKGROUND_PIDS+=($!)
   for _ in $(seq 50); do [ -s "$LOG_DIR/demo-xvfb-display" ] && break; sleep 0.2; done
   display=:$(cat "$LOG_DIR/demo-xvfb-display")
+  # The replay is over and nothing publishes tf: the bag's last transform of every frame, held
+  # on /tf_static while rviz draws, so that its fixed frame exists and its TF display shows where
+  # the sensors ended.
+  python3 - "$bag" >"$LOG_DIR/demo-last-tf.log" 2>&1 <<'PY' &
+import sys
+import rosbag
+import rospy
+from tf2_msgs.msg import TFMessage
+last = {}
+with rosbag.Bag(sys.argv[1]) as bag:
+    for _, message, _ in bag.read_messages(topics=["/tf", "/tf_static"]):
+        for transform in message.transforms:
+            last[(transform.header.frame_id, transform.child_frame_id)] = transform
+rospy.init_node("demo_last_tf", anonymous=True)
+publisher = rospy.Publisher("/tf_static", TFMessage, queue_size=1, latch=True)
+publisher.publish(TFMessage(transforms=list(last.values())))
+rospy.spin()
+PY
+  BACKGROUND_PIDS+=($!)
   DISPLAY=$display rviz -d "$output/mvog.rviz" >"$LOG_DIR/demo-rviz.log" 2>&1 &
   BACKGROUND_PIDS+=($!)
   # Once rviz has subscribed to the markers (sent whole to a new subscriber), time to draw them.
