@@ -173,9 +173,11 @@ screenshot=""
 if command -v Xvfb >/dev/null && command -v rviz >/dev/null; then
   # Xvfb picks a free display itself and writes its number to the file descriptor given.
   rm -f "$LOG_DIR/demo-xvfb-display"  # the loop below must not read a previous run's number
-  # The screen is the size of rviz's window (rviz/mvog.rviz, Window Geometry): the screenshot is
-  # the window alone.
-  Xvfb -displayfd 3 -screen 0 1200x800x24 3>"$LOG_DIR/demo-xvfb-display" >"$LOG_DIR/demo-xvfb.log" 2>&1 &
+  # The screen is the size of rviz's window (its view's Window Geometry): the screenshot is the
+  # window alone.
+  window_width=$(sed -n '/^Window Geometry:/,$ s/^  Width: //p' "$output/mvog.rviz")
+  window_height=$(sed -n '/^Window Geometry:/,$ s/^  Height: //p' "$output/mvog.rviz")
+  Xvfb -displayfd 3 -screen 0 "${window_width}x${window_height}x24" 3>"$LOG_DIR/demo-xvfb-display" >"$LOG_DIR/demo-xvfb.log" 2>&1 &
   BACKGROUND_PIDS+=($!)
   for _ in $(seq 50); do [ -s "$LOG_DIR/demo-xvfb-display" ] && break; sleep 0.2; done
   display=:$(cat "$LOG_DIR/demo-xvfb-display")
