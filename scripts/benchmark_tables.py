@@ -50,6 +50,29 @@ def megabytes(value):
     return f"{value / 1e6:.2f}"
 
 
+AGAINST_OCTOMAP_COLUMNS = [
+    "res (m)", "readings", "ends occupied: MVOG / OctoMap", "along free: MVOG / OctoMap",
+    "far unknown: MVOG / OctoMap", "MVOG / OctoMap speed", "MVOG / walk time",
+    "MVOG / OctoMap memory"]
+
+
+def against_octomap_row(name, resolution, run):
+    """One resolution of an mvog_bench run of all backends: each backend's quality, and MVOG's
+    speed and memory as ratios (AGAINST_OCTOMAP_COLUMNS)."""
+    mvog_quality, octomap_quality, results, comparison = by_backend(run)
+    m, o = mvog_quality[resolution], octomap_quality[resolution]
+
+    def both(key):
+        return f"{percent(m[key])} / {percent(o[key])}"
+
+    return [name, f"{resolution:g}", f"{results['mvog'][resolution]['readings']:,}",
+            both("endpoints_occupied_percent"), both("along_rays_free_percent"),
+            both("far_unknown_percent"),
+            f"{comparison[resolution]['readings_per_second_ratio']:.1f}x",
+            f"{results['walk'][resolution]['mvog_time_ratio']:.2f}x",
+            f"{comparison[resolution]['memory_ratio']:.3f}x"]
+
+
 def main(out):
     runs = {file_name(p, "all_"): load(p) for p in sorted(glob.glob(f"{out}/all_*.json"))}
     paper = {file_name(p, "paper_"): load(p) for p in glob.glob(f"{out}/paper_*.json")}
@@ -118,30 +141,27 @@ def main(out):
                  "Table I: MVOG", "Table I: OctoMap", "MVOG file", "OctoMap .ot file"], memory))
     print("\n### Threads (0.05 m)\n")
     print(table(["file", "1 thread (s)", "2 threads (s)", "speed-up", "same map"], threads))
-    synthetic_rows = []
-    for path in sorted(glob.glob(f"{out}/synthetic_*.json")):
-        mvog_quality, octomap_quality, results, comparison = by_backend(load(path))
-        for resolution in sorted(mvog_quality, reverse=True):
-            m, o = mvog_quality[resolution], octomap_quality[resolution]
-            synthetic_rows.append([
-                file_name(path, "synthetic_"), f"{resolution:g}",
-                f"{results['mvog'][resolution]['readings']:,}",
-                f"{percent(m['endpoints_occupied_percent'])} / "
-                f"{percent(o['endpoints_occupied_percent'])}",
-                f"{percent(m['along_rays_free_percent'])} / "
-                f"{percent(o['along_rays_free_percent'])}",
-                f"{percent(m['far_unknown_percent'])} / {percent(o['far_unknown_percent'])}",
-                f"{comparison[resolution]['readings_per_second_ratio']:.1f}x",
-                f"{results['walk'][resolution]['mvog_time_ratio']:.2f}x",
-                f"{comparison[resolution]['memory_ratio']:.3f}x",
-            ])
+    other_resolutions = {file_name(p, "resolutions_"): load(p)
+                         for p in glob.glob(f"{out}/resolutions_*.json")}
+    if other_resolutions:
+        rows = [(name, resolution, source)
+                for name, run in runs.items()
+                for source in [run, other_resolutions.get(name)] if source is not None
+                for resolution in by_resolution(source["quality"], "mvog")]
+        rows.sort(key=lambda r: (r[0], -r[1]))
+        print("\n### Every file at 0.1, 0.05 and 0.02 m (one thread)\n")
+        print(table(["file"] + AGAINST_OCTOMAP_COLUMNS,
+                    [against_octomap_row(name, resolution, source)
+                     for name, resolution, source in rows]))
+    synthetic_rows = [against_octomap_row(file_name(path, "synthetic_"), resolution, run)
+                      for path in sorted(glob.glob(f"{out}/synthetic_*.json"))
+                      for run in [load(path)]
+                      for resolution in sorted(by_resolution(run["quality"], "mvog"),
+                                               reverse=True)]
     if synthetic_rows:
         print("\n### Sensors none of the recordings has (mvog_bench --input synthetic:NAME, "
               "one insertion)\n")
-        print(table(["sensor", "res (m)", "readings", "ends occupied: MVOG / OctoMap",
-                     "along free: MVOG / OctoMap", "far unknown: MVOG / OctoMap",
-                     "MVOG / OctoMap speed", "MVOG / walk time", "MVOG / OctoMap memory"],
-                    synthetic_rows))
+        print(table(["sensor"] + AGAINST_OCTOMAP_COLUMNS, synthetic_rows))
 
     def quality_at(run, resolution=0.05):
         q = by_resolution(run["quality"], "mvog").get(resolution)

@@ -46,11 +46,22 @@ for file in "${FILES[@]}"; do
   run_bench "paper_$file" --input "$MVOG_DATA_DIR/$file" "${resolutions[@]}" --backend mvog \
     --model paper
 done
-# Two threads next to the one-thread runs above, before the runs that hold gigabytes (Table I's
-# OctoMap at 0.02 m), after which two threads ran up to 1.4x slower for a while.
+# Two threads next to the one-thread runs above, before the runs that hold gigabytes (OctoMap at
+# 0.02 m), after which two threads ran up to 1.4x slower for a while.
 for file in "${THREADED_FILES[@]}"; do
   run_bench "threads2_$file" --input "$MVOG_DATA_DIR/$file" --resolution 0.05 --backend mvog \
     --threads 2
+done
+# Every file also at the resolutions the runs above leave out (0.1 and 0.02 m; 0.02 m for the 2D
+# logs), the three backends on the same rays: how the ratios move with the cell size a user
+# chooses. After the two-thread runs: OctoMap's trees at 0.02 m hold up to gigabytes.
+declare -A OTHER_RESOLUTIONS=(
+  [intel_lab.bag]="0.02" [people_stationary.bag]="0.02"
+)
+for file in "${FILES[@]}"; do
+  resolutions=()
+  for r in ${OTHER_RESOLUTIONS[$file]:-0.1 0.02}; do resolutions+=(--resolution "$r"); done
+  run_bench "resolutions_$file" --input "$MVOG_DATA_DIR/$file" "${resolutions[@]}" --backend all
 done
 # The rules one at a time, MVOG alone at 0.05 m on every file (the quality only: one insertion).
 declare -A RULE_OPTIONS=(
