@@ -32,6 +32,13 @@ FILES=(spherical_scan.graph newcollege_excerpt.bag intel_lab.bag people_stationa
 THREADED_FILES=(kurt3d_3scans.graph tum_fr2_pioneer_slam2_10frames.graph
   tum_fr2_pioneer_10frames.bag)
 
+# resolution_options "R1 R2 ...": RESOLUTION_OPTIONS, `--resolution R` for each R.
+resolution_options() {
+  RESOLUTION_OPTIONS=()
+  local r
+  for r in $1; do RESOLUTION_OPTIONS+=(--resolution "$r"); done
+}
+
 run_bench() {
   local name=$1
   shift
@@ -40,10 +47,9 @@ run_bench() {
 }
 
 for file in "${FILES[@]}"; do
-  resolutions=()
-  for r in ${RESOLUTIONS[$file]:-0.05}; do resolutions+=(--resolution "$r"); done
-  run_bench "all_$file" --input "$MVOG_DATA_DIR/$file" "${resolutions[@]}" --backend all
-  run_bench "paper_$file" --input "$MVOG_DATA_DIR/$file" "${resolutions[@]}" --backend mvog \
+  resolution_options "${RESOLUTIONS[$file]:-0.05}"
+  run_bench "all_$file" --input "$MVOG_DATA_DIR/$file" "${RESOLUTION_OPTIONS[@]}" --backend all
+  run_bench "paper_$file" --input "$MVOG_DATA_DIR/$file" "${RESOLUTION_OPTIONS[@]}" --backend mvog \
     --model paper
 done
 # Two threads next to the one-thread runs above, before the runs that hold gigabytes (OctoMap at
@@ -59,9 +65,9 @@ declare -A OTHER_RESOLUTIONS=(
   [intel_lab.bag]="0.02" [people_stationary.bag]="0.02"
 )
 for file in "${FILES[@]}"; do
-  resolutions=()
-  for r in ${OTHER_RESOLUTIONS[$file]:-0.1 0.02}; do resolutions+=(--resolution "$r"); done
-  run_bench "resolutions_$file" --input "$MVOG_DATA_DIR/$file" "${resolutions[@]}" --backend all
+  resolution_options "${OTHER_RESOLUTIONS[$file]:-0.1 0.02}"
+  run_bench "resolutions_$file" --input "$MVOG_DATA_DIR/$file" "${RESOLUTION_OPTIONS[@]}" \
+    --backend all
 done
 # The rules one at a time, MVOG alone at 0.05 m on every file (the quality only: one insertion).
 declare -A RULE_OPTIONS=(
