@@ -11,6 +11,7 @@
 namespace mvog {
 namespace {
 
+using detail::ColumnWork;
 using detail::ScanInterval;
 
 /// A run of volumes to change.
@@ -65,27 +66,6 @@ void addedVolumes(const std::vector<ScanInterval>& free, const std::vector<ScanI
     if (below < i.top) keep(below, i.top);
   }
 }
-
-}  // namespace
-
-/// One thread's working memory while applying a scan.
-struct ColumnWork {
-  ListMerger merger;
-  /// The scratches that reached the tile being updated, and their part of it.
-  std::vector<std::pair<const detail::ScanScratch*, const detail::ScratchTile*>> parts;
-  std::vector<detail::TileHit> hits;                  // the tile's, by cell (gatherTile)
-  std::vector<detail::TileHit> sorted_hits;           // gatherTile's counting sort's output
-  std::uint64_t reached[detail::kCellsPerTile / 64];  // the cells the scan reached
-  std::vector<ScanInterval> free;
-  std::vector<ScanInterval> positive;
-  CellVolumes added;
-  CellVolumes merged;
-  /// The new lists of the tile's cells whose lists changed length.
-  detail::TileBlock::Rewrite rewrite;
-  CellRange grown = kNoCells;  // cells that received their first volume
-};
-
-namespace {
 
 /// Whether hit a comes before hit b: by cell, then by height.
 bool hitBefore(const detail::TileHit& a, const detail::TileHit& b) {
@@ -489,7 +469,9 @@ InsertionResult Map::apply(ScanUpdate& update) {
   const float unit_mass = static_cast<float>(1.0 / mass_unit_);
   const auto exponent = static_cast<std::int32_t>(unit_exponent_);
   const std::size_t num_threads = impl.scratches.size();
-  std::vector<ColumnWork> work(num_threads);
+  std::vector<ColumnWork>& work = impl.column_work;
+  if (work.size() < num_threads) work.resize(num_threads);
+  for (ColumnWork& w : work) w.grown = kNoCells;
   auto update_tile = [&](std::size_t worker, std::size_t k) {
     detail::TileBlock& tile = *tiles[k];
     const double rescale = tile.empty() ? 1.0 : rescaleOf(tile.exponent());

@@ -10,6 +10,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "mvog/constraints.h"
 #include "mvog/scan_update.h"
 #include "thread_pool.h"
 #include "tile_block.h"
@@ -354,6 +355,24 @@ inline float joinGapOf(const ModelRules& rules) {
   return rules.mass_counting == MassCounting::kPerScan ? kMaxMergeGap : 0.0f;
 }
 
+/// One thread's working memory while Map::apply applies a scan (ScanUpdate::Impl keeps it from
+/// scan to scan).
+struct ColumnWork {
+  ListMerger merger;
+  /// The scratches that reached the tile being updated, and their part of it.
+  std::vector<std::pair<const ScanScratch*, const ScratchTile*>> parts;
+  std::vector<TileHit> hits;                  // the tile's, by cell (gatherTile)
+  std::vector<TileHit> sorted_hits;           // gatherTile's counting sort's output
+  std::uint64_t reached[kCellsPerTile / 64];  // the cells the scan reached
+  std::vector<ScanInterval> free;
+  std::vector<ScanInterval> positive;
+  CellVolumes added;
+  CellVolumes merged;
+  /// The new lists of the tile's cells whose lists changed length.
+  TileBlock::Rewrite rewrite;
+  CellRange grown = kNoCells;  // cells that received their first volume
+};
+
 }  // namespace detail
 
 struct ScanUpdate::Impl {
@@ -364,6 +383,9 @@ struct ScanUpdate::Impl {
   /// With several threads: the scratch of each reading of the scan (splitReadingsBySector).
   detail::ReadingSplit split;
   std::unique_ptr<detail::ThreadPool> pool;
+  /// Map::apply's working memory, one per thread: its buffers keep their capacity from scan to
+  /// scan instead of growing anew at each.
+  std::vector<detail::ColumnWork> column_work;
 
   /// Threads for `insertion_threads`, started once.
   detail::ThreadPool* threads(std::size_t count);

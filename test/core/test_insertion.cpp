@@ -759,6 +759,39 @@ TEST(Insertion, PreparingOutsideTheMapAndApplyingBuildTheSameMap) {
   EXPECT_THROW(two_phases.apply(update), ConfigError);
 }
 
+TEST(Insertion, OneUpdateAppliedToMapsInTurnBuildsEachAsItsOwnInsertionWould) {
+  // An update keeps its working memory from scan to scan, whichever map it is applied to and
+  // with however many threads: nothing of one application may reach the next (the cells a scan
+  // gave their first volume among them, which make the map's bounds).
+  MapConfig map_config;
+  map_config.resolution = 0.25;
+  Map near(map_config), far(map_config), near_direct(map_config), far_direct(map_config);
+  ScanUpdate update;
+  std::mt19937 rng(11);
+  for (int k = 0; k < 4; ++k) {
+    const Scan near_scan = test::randomScan(rng, {0.0, 0.0, 0.0}, 1500, 300, 6.0);
+    const Scan far_scan = test::randomScan(rng, {60.0, -40.0, 2.0}, 1500, 300, 6.0);
+    InsertionConfig insertion;
+    insertion.insertion_threads = 1 + k % 3;
+    update.prepare(near_scan, map_config, insertion);
+    near.apply(update);
+    insertion.insertion_threads = 1 + (k + 1) % 3;
+    update.prepare(far_scan, map_config, insertion);
+    far.apply(update);
+    near_direct.insertScan(near_scan);
+    far_direct.insertScan(far_scan);
+  }
+  EXPECT_TRUE(test::sameVolumes(allVolumes(near), allVolumes(near_direct)));
+  EXPECT_TRUE(test::sameVolumes(allVolumes(far), allVolumes(far_direct)));
+  for (const auto& [map, direct] : {std::pair<const Map*, const Map*>{&near, &near_direct},
+                                    std::pair<const Map*, const Map*>{&far, &far_direct}}) {
+    EXPECT_EQ(map->bounds().min.x, direct->bounds().min.x);
+    EXPECT_EQ(map->bounds().min.y, direct->bounds().min.y);
+    EXPECT_EQ(map->bounds().max.x, direct->bounds().max.x);
+    EXPECT_EQ(map->bounds().max.y, direct->bounds().max.y);
+  }
+}
+
 TEST(Insertion, EveryRuleSetEqualsThePlainReference) {
   // The map against test::ReferenceModel, scan after scan: the scratch tiles, the joins, the
   // shortcuts and tiles written in place change nothing the rules decide.
