@@ -207,16 +207,21 @@ TileBlock TileBlock::Builder::finish(std::int32_t exponent, std::uint64_t modifi
                   std::size_t{num_volumes} * sizeof(Volume));
     }
   }
+  clear();
+  return tile;
+}
+
+void TileBlock::Builder::clear() {
   locals_.clear();
   starts_.clear();
   num_positive_.clear();
   volumes_.clear();
-  return tile;
 }
 
 void TileBlock::Rewrite::clear() {
   cells_.clear();
   volumes_.clear();
+  builder_.clear();
 }
 
 void TileBlock::Rewrite::set(unsigned local, const ColumnRef& lists) {

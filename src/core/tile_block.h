@@ -178,6 +178,8 @@ class TileBlock {
     void addUnchanged(const TileBlock& tile, unsigned first, unsigned end);
     /// The tile of the cells added (empty if none), which the builder then forgets.
     TileBlock finish(std::int32_t exponent, std::uint64_t modified_revision);
+    /// Forgets the cells added, keeping its buffers' capacity.
+    void clear();
 
    private:
     std::vector<std::uint16_t> locals_;
@@ -190,6 +192,7 @@ class TileBlock {
   /// them and its other cells copied.
   class Rewrite {
    public:
+    /// Forgets every cell set (and what an apply() that threw left in its builder).
     void clear();
     /// The new lists of cell `local` (both empty: the cell goes), in increasing local index.
     void set(unsigned local, const ColumnRef& lists);
