@@ -7,7 +7,7 @@
 # instruction counts of the three insertions (callgrind: the ratios the machine's load cannot
 # disturb); writes the outputs (JSON and text) to OUT and prints the report's tables
 # (scripts/benchmark_tables.py).
-#   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~30 min here)
+#   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~40 min here)
 # MVOG_BENCH_REPEAT (default 3): insertions per backend, the fastest reported.
 # shellcheck source=scripts/common.sh
 source "$(dirname "$0")/common.sh"
