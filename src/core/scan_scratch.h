@@ -112,8 +112,14 @@ inline bool intervalsJoin(float bottom, float top, float other_bottom, float oth
   return std::max(bottom - other_top, other_bottom - top) <= join_gap;
 }
 
+/// The cache line: each thread's working memory (ScanScratch, ColumnWork) starts on one of its
+/// own. Side by side in a vector, one thread's writes (an arena's use, a merge's buffers) would
+/// otherwise share a line with what the next thread reads at every step (its dense index), and
+/// evict it from that thread's cache (false sharing), as the vector's place in memory happens.
+constexpr std::size_t kCacheLine = 64;
+
 /// One thread's part of a scan: the tiles its readings' walks entered.
-class ScanScratch {
+class alignas(kCacheLine) ScanScratch {
  public:
   /// Forgets the previous scan (its memory is kept for the next). Intervals less than
   /// `join_gap` apart will join (0: only overlapping or touching ones); masses are summed only
@@ -357,7 +363,7 @@ inline float joinGapOf(const ModelRules& rules) {
 
 /// One thread's working memory while Map::apply applies a scan (ScanUpdate::Impl keeps it from
 /// scan to scan).
-struct ColumnWork {
+struct alignas(kCacheLine) ColumnWork {
   ListMerger merger;
   /// The scratches that reached the tile being updated, and their part of it.
   std::vector<std::pair<const ScanScratch*, const ScratchTile*>> parts;
