@@ -113,9 +113,10 @@ inline bool intervalsJoin(float bottom, float top, float other_bottom, float oth
 }
 
 /// The cache line: each thread's working memory (ScanScratch, ColumnWork) starts on one of its
-/// own. Side by side in a vector, one thread's writes (an arena's use, a merge's buffers) would
-/// otherwise share a line with what the next thread reads at every step (its dense index), and
-/// evict it from that thread's cache (false sharing), as the vector's place in memory happens.
+/// own. Side by side in a vector, the end of one thread's struct and the start of the next one's
+/// could share a line, wherever the vector lay (an arena's fill beside the list of tiles entered,
+/// a tile's rewrite beside the merge's buffers): each thread's writes then evicted what the other
+/// used (false sharing).
 constexpr std::size_t kCacheLine = 64;
 
 /// One thread's part of a scan: the tiles its readings' walks entered.
