@@ -13,9 +13,9 @@ export MVOG_DATA_DIR=${MVOG_DATA_DIR:-$(cd "$REPO/.." && pwd)/shared/data}
 
 # Debian 12 packages: ROS 1 (Debian's own build), PCL, OctoMap, test and headless-rviz tools,
 # valgrind (scripts/benchmarks.sh's instruction counts), clang with its sanitizer and libFuzzer
-# runtimes (scripts/sanitizers.sh), the linters (scripts/lint.sh).
+# runtimes and ninja (scripts/sanitizers.sh), the linters (scripts/lint.sh).
 MVOG_PACKAGES=(
-  build-essential cmake libeigen3-dev libgtest-dev libbenchmark-dev
+  build-essential cmake ninja-build libeigen3-dev libgtest-dev libbenchmark-dev
   ros-core-python-dev ros-base-dev python3-rostest rosbash python3-rosbag python3-numpy
   python3-rospy python3-sensor-msgs python3-geometry-msgs python3-tf2-msgs python3-tf2-ros
   python3-diagnostic-msgs python3-std-srvs
