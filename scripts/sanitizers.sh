@@ -54,7 +54,8 @@ build() {
   ninja_tree "$BUILD_ROOT/$mode"
   quietly "sanitizer-$mode-configure" env CXX="$compiler" cmake -G Ninja \
     -S "$REPO/test/sanitizers" -B "$BUILD_ROOT/$mode" -DMVOG_SANITIZER="$mode" \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 &&
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 \
+    -DCMAKE_UNITY_BUILD=ON &&
     quietly "sanitizer-$mode-build" cmake --build "$BUILD_ROOT/$mode" -j2 --target "$@"
 }
 
@@ -90,10 +91,10 @@ fuzz_targets=(map_file map_update conversions)
 # those of the nodelet: an instrumented plugin cannot be loaded into Debian's uninstrumented
 # nodelet manager; not the replays of ../shared/data: minutes each). -O1 as ASan's authors
 # advise: less compile time than -O2 for the same checks; -g1: the line tables a report's stack
-# trace needs (file:line), without -g's variable descriptions (less to compile and link); the ROS
-# layer's library as a unity build (MVOG_UNITY_BUILD_ROS in CMakeLists.txt: the ROS headers parsed
-# a few times instead of once per file). A sanitizer report by any process fails the check and is
-# appended to its log.
+# trace needs (file:line), without -g's variable descriptions (less to compile and link); a unity
+# build, as every build of this script (CMAKE_UNITY_BUILD: the ROS and gtest headers parsed once
+# a batch of sources instead of once a file). A sanitizer report by any process fails the check
+# and is appended to its log.
 asan_workspace=$BUILD_ROOT/catkin
 sanitize="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all"
 # in_asan_workspace NAME COMMAND...: runs COMMAND with the instrumented workspace sourced, its
@@ -133,7 +134,7 @@ if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make --use-nin
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DCMAKE_CXX_FLAGS="$sanitize -fno-omit-frame-pointer" -DCMAKE_EXE_LINKER_FLAGS="$sanitize" \
   -DCMAKE_SHARED_LINKER_FLAGS="$sanitize" -DCATKIN_ENABLE_TESTING=ON -DMVOG_FUZZ_TARGETS=replay \
-  -DMVOG_UNITY_BUILD_ROS=ON \
+  -DCMAKE_UNITY_BUILD=ON \
   -j2 mvog_node test_mapper_node test_planning_node mvog_generate_messages "${asan_programs[@]}" \
   "${fuzz_targets[@]/#/fuzz_replay_}"); then
   asan_built=true

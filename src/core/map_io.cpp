@@ -17,13 +17,15 @@
 namespace mvog {
 namespace {
 
-constexpr char kMagic[8] = {'M', 'V', 'O', 'G', 'M', 'A', 'P', '\0'};
+constexpr char kMapFileMagic[8] = {'M', 'V', 'O', 'G', 'M', 'A', 'P', '\0'};
 constexpr std::size_t kCellRecordBytes = detail::kCellRecordBytes;
 constexpr std::size_t kChecksumBytes = detail::kChecksumBytes;
 using detail::Reader;
 using detail::Writer;
 
-[[noreturn]] void fail(const std::string& what) { throw MapFileError("invalid map: " + what); }
+[[noreturn]] void invalidMap(const std::string& what) {
+  throw MapFileError("invalid map: " + what);
+}
 
 std::string systemError(const std::string& what, const std::string& path) {
   return what + " '" + path + "': " + std::strerror(errno);
@@ -48,7 +50,7 @@ std::vector<std::uint8_t> serializeMap(const Map& map) {
   out.reserve(kMapHeaderBytes + kCellRecordBytes * cell_count +
               detail::kVolumeRecordBytes * volume_count + kChecksumBytes);
   Writer writer(out);
-  writer.bytes(kMagic, sizeof(kMagic));
+  writer.bytes(kMapFileMagic, sizeof(kMapFileMagic));
   writer.u32(kMapFormatVersion);
   writer.u32(static_cast<std::uint32_t>(kMapHeaderBytes));
   writer.f64(map.config().resolution);
@@ -80,44 +82,46 @@ std::vector<std::uint8_t> serializeMap(const Map& map) {
 
 Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   if (data == nullptr || size < kMapHeaderBytes + kChecksumBytes) {
-    fail("truncated: " + std::to_string(size) + " bytes is less than a header and a checksum");
+    invalidMap("truncated: " + std::to_string(size) +
+               " bytes is less than a header and a checksum");
   }
-  if (std::memcmp(data, kMagic, sizeof(kMagic)) != 0) fail("not an MVOG map (bad magic)");
-  Reader header(data, sizeof(kMagic));
+  if (std::memcmp(data, kMapFileMagic, sizeof(kMapFileMagic)) != 0)
+    invalidMap("not an MVOG map (bad magic)");
+  Reader header(data, sizeof(kMapFileMagic));
   const std::uint32_t version = header.u32();
   if (version != kMapFormatVersion && version != 1) {
-    fail("format version " + std::to_string(version) + " is not supported (expected 1 or " +
-         std::to_string(kMapFormatVersion) + ")");
+    invalidMap("format version " + std::to_string(version) + " is not supported (expected 1 or " +
+               std::to_string(kMapFormatVersion) + ")");
   }
-  if (header.u32() != kMapHeaderBytes) fail("unexpected header size");
+  if (header.u32() != kMapHeaderBytes) invalidMap("unexpected header size");
   MapConfig config;
   config.resolution = header.f64();
   config.max_coordinate = header.f64();
   const std::uint64_t cell_count = header.u64();
   const std::uint64_t volume_count = header.u64();
   const std::uint32_t rules = header.u32();
-  if (rules & ~detail::kAllRuleBits) fail("unknown bits in the model's rules");
+  if (rules & ~detail::kAllRuleBits) invalidMap("unknown bits in the model's rules");
   config.rules = detail::rulesOf(rules);
   if (version == 1) {
-    if (header.u64() != 0 || header.u32() != 0) fail("reserved header bytes are not zero");
+    if (header.u64() != 0 || header.u32() != 0) invalidMap("reserved header bytes are not zero");
   } else {
     config.rules.out_of_range_free_length = header.f64();
-    if (header.u32() != 0) fail("reserved header bytes are not zero");
+    if (header.u32() != 0) invalidMap("reserved header bytes are not zero");
   }
   // Check the counts against the real size before trusting them for anything.
   const std::size_t body = size - kMapHeaderBytes - kChecksumBytes;
   if (cell_count > body / kCellRecordBytes || volume_count > body / detail::kVolumeRecordBytes ||
       cell_count * kCellRecordBytes + volume_count * detail::kVolumeRecordBytes != body) {
-    fail("the header's counts (" + std::to_string(cell_count) + " cells, " +
-         std::to_string(volume_count) + " volumes) do not match the size of " +
-         std::to_string(size) + " bytes (truncated or corrupted)");
+    invalidMap("the header's counts (" + std::to_string(cell_count) + " cells, " +
+               std::to_string(volume_count) + " volumes) do not match the size of " +
+               std::to_string(size) + " bytes (truncated or corrupted)");
   }
-  if (!detail::checksumMatches(data, size)) fail("checksum mismatch (corrupted)");
+  if (!detail::checksumMatches(data, size)) invalidMap("checksum mismatch (corrupted)");
   Map map = [&] {
     try {
       return Map(config);
     } catch (const ConfigError& e) {
-      fail(std::string("bad header: ") + e.what());
+      invalidMap(std::string("bad header: ") + e.what());
     }
   }();
 
@@ -135,7 +139,7 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     try {
       map.setCellVolumes(batch);  // checks the constraints and max_coordinate
     } catch (const ConfigError& e) {
-      fail(e.what());
+      invalidMap(e.what());
     }
     batch.clear();
   };
@@ -143,10 +147,10 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     Map::CellAssignment assignment;
     const std::string problem =
         detail::readCell(reader, volume_count - volumes_read, assignment.cell, assignment.volumes);
-    if (!problem.empty()) fail(problem);
+    if (!problem.empty()) invalidMap(problem);
     const CellIndex& cell = assignment.cell;
     if (!seen.insert(detail::cellKey(cell)).second) {
-      fail(detail::cellName(cell).append(" appears twice"));
+      invalidMap(detail::cellName(cell).append(" appears twice"));
     }
     volumes_read += assignment.volumes.positive.size() + assignment.volumes.negative.size();
     if (batch.size() >= kCellsPerBatch &&
@@ -155,7 +159,7 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     }
     batch.push_back(std::move(assignment));
   }
-  if (volumes_read != volume_count) fail("fewer volumes than the header counts");
+  if (volumes_read != volume_count) invalidMap("fewer volumes than the header counts");
   apply_batch();
   return map;
 }

@@ -33,12 +33,12 @@ struct UpdateBody {
 
 namespace {
 
-constexpr char kMagic[8] = {'M', 'V', 'O', 'G', 'U', 'P', 'D', '\0'};
+constexpr char kUpdateMagic[8] = {'M', 'V', 'O', 'G', 'U', 'P', 'D', '\0'};
 constexpr std::uint32_t kFullFlag = 1u;
 constexpr std::size_t kRemovedTileBytes = 8;
 constexpr std::size_t kTileRecordBytes = 16;
 
-[[noreturn]] void fail(const std::string& what) {
+[[noreturn]] void invalidUpdate(const std::string& what) {
   throw MapFileError("invalid map update: " + what);
 }
 
@@ -47,25 +47,27 @@ using detail::UpdateHeader;
 
 UpdateHeader readHeader(const std::uint8_t* data, std::size_t size) {
   if (data == nullptr || size < kMapUpdateHeaderBytes + detail::kChecksumBytes) {
-    fail("truncated: " + std::to_string(size) + " bytes is less than a header and a checksum");
+    invalidUpdate("truncated: " + std::to_string(size) +
+                  " bytes is less than a header and a checksum");
   }
-  if (std::memcmp(data, kMagic, sizeof(kMagic)) != 0) fail("not an MVOG map update (bad magic)");
-  detail::Reader reader(data, sizeof(kMagic));
+  if (std::memcmp(data, kUpdateMagic, sizeof(kUpdateMagic)) != 0)
+    invalidUpdate("not an MVOG map update (bad magic)");
+  detail::Reader reader(data, sizeof(kUpdateMagic));
   const std::uint32_t version = reader.u32();
   if (version != kMapUpdateFormatVersion) {
-    fail("format version " + std::to_string(version) + " is not supported (expected " +
-         std::to_string(kMapUpdateFormatVersion) + ")");
+    invalidUpdate("format version " + std::to_string(version) + " is not supported (expected " +
+                  std::to_string(kMapUpdateFormatVersion) + ")");
   }
-  if (reader.u32() != kMapUpdateHeaderBytes) fail("unexpected header size");
+  if (reader.u32() != kMapUpdateHeaderBytes) invalidUpdate("unexpected header size");
   UpdateHeader header;
   header.config.resolution = reader.f64();
   header.config.max_coordinate = reader.f64();
   const std::uint32_t rules = reader.u32();
-  if (rules & ~detail::kAllRuleBits) fail("unknown bits in the model's rules");
+  if (rules & ~detail::kAllRuleBits) invalidUpdate("unknown bits in the model's rules");
   header.config.rules = detail::rulesOf(rules);
   header.config.rules.out_of_range_free_length = reader.f64();
   const std::uint32_t flags = reader.u32();
-  if (flags & ~kFullFlag) fail("unknown flags");
+  if (flags & ~kFullFlag) invalidUpdate("unknown flags");
   MapUpdateInfo& info = header.info;
   info.full = (flags & kFullFlag) != 0;
   info.source = reader.u64();
@@ -77,7 +79,7 @@ UpdateHeader readHeader(const std::uint8_t* data, std::size_t size) {
   const std::uint64_t num_tiles = reader.u64();
   header.num_cells = reader.u64();
   header.num_volumes = reader.u64();
-  if (reader.u64() != 0) fail("reserved header bytes are not zero");
+  if (reader.u64() != 0) invalidUpdate("reserved header bytes are not zero");
   // Check the counts against the real size before trusting them for anything.
   const std::size_t body = size - kMapUpdateHeaderBytes - detail::kChecksumBytes;
   if (num_removed > body / kRemovedTileBytes || num_tiles > body / kTileRecordBytes ||
@@ -87,22 +89,24 @@ UpdateHeader readHeader(const std::uint8_t* data, std::size_t size) {
               header.num_cells * detail::kCellRecordBytes +
               header.num_volumes * detail::kVolumeRecordBytes !=
           body) {
-    fail("the header's counts do not match the size of " + std::to_string(size) +
-         " bytes (truncated or corrupted)");
+    invalidUpdate("the header's counts do not match the size of " + std::to_string(size) +
+                  " bytes (truncated or corrupted)");
   }
-  if (!detail::checksumMatches(data, size)) fail("checksum mismatch (corrupted)");
+  if (!detail::checksumMatches(data, size)) invalidUpdate("checksum mismatch (corrupted)");
   try {
     header.config.validate();
   } catch (const ConfigError& e) {
-    fail(std::string("bad header: ") + e.what());
+    invalidUpdate(std::string("bad header: ") + e.what());
   }
-  if (info.from_revision > info.to_revision) fail("the from revision is after the to revision");
+  if (info.from_revision > info.to_revision)
+    invalidUpdate("the from revision is after the to revision");
   if (info.full && (info.from_revision != 0 || num_removed != 0)) {
-    fail("a full update with a from revision or removed tiles");
+    invalidUpdate("a full update with a from revision or removed tiles");
   }
-  if (!(header.mass_unit > 0.5 && header.mass_unit <= 1.0)) fail("mass unit not in (0.5, 1]");
+  if (!(header.mass_unit > 0.5 && header.mass_unit <= 1.0))
+    invalidUpdate("mass unit not in (0.5, 1]");
   if (header.unit_exponent < detail::kMinUnitExponent || header.unit_exponent > 0) {
-    fail("unit exponent not in [-2^24, 0]");
+    invalidUpdate("unit exponent not in [-2^24, 0]");
   }
   info.resolution = header.config.resolution;
   info.tiles_removed = static_cast<std::size_t>(num_removed);
@@ -120,7 +124,7 @@ UpdateBody readBody(const std::uint8_t* data, const UpdateHeader& header) {
   std::vector<std::uint64_t> removed = body.removed;
   std::sort(removed.begin(), removed.end());
   if (std::adjacent_find(removed.begin(), removed.end()) != removed.end()) {
-    fail("a tile is listed removed twice");
+    invalidUpdate("a tile is listed removed twice");
   }
   const double max_cell = header.config.max_coordinate / header.config.resolution + 1.0;
   const bool split = header.config.rules.split_free_space_at_obstacles;
@@ -138,25 +142,25 @@ UpdateBody readBody(const std::uint8_t* data, const UpdateHeader& header) {
     const std::uint32_t num_cells = reader.u32();
     const std::string where = detail::tileName(key);
     if (!body.tiles.empty() && !detail::rowMajorBefore(body.tiles.back().first, key)) {
-      fail(where + " is out of order or listed twice");
+      invalidUpdate(where + " is out of order or listed twice");
     }
     if (std::binary_search(removed.begin(), removed.end(), key)) {
-      fail(where + " is listed both changed and removed");
+      invalidUpdate(where + " is listed both changed and removed");
     }
     if (exponent < header.unit_exponent || exponent > detail::kMaxExponentLag) {
-      fail(where + ": exponent not in [unit exponent, 2^24]");
+      invalidUpdate(where + ": exponent not in [unit exponent, 2^24]");
     }
     if (num_cells == 0 || num_cells > detail::kCellsPerTile || num_cells > cells_left) {
-      fail(where + ": " + std::to_string(num_cells) + " cells");
+      invalidUpdate(where + ": " + std::to_string(num_cells) + " cells");
     }
     cells_left -= num_cells;
     int previous_local = -1;
     for (std::uint32_t c = 0; c < num_cells; ++c) {
       const std::string problem = detail::readCell(reader, volumes_left, cell, volumes);
-      if (!problem.empty()) fail(problem);
+      if (!problem.empty()) invalidUpdate(problem);
       // The cell's name is made only for a message: this loop reads every cell of an update.
       auto fail_at_cell = [&](const std::string& what) {
-        fail(detail::cellName(cell).append(what));
+        invalidUpdate(detail::cellName(cell).append(what));
       };
       if (detail::tileKeyOf(cell) != key) fail_at_cell(" is not in " + where);
       const auto local = static_cast<int>(detail::localIndex(cell));
@@ -176,7 +180,8 @@ UpdateBody readBody(const std::uint8_t* data, const UpdateHeader& header) {
     }
     body.tiles.emplace_back(key, builder.finish(static_cast<std::int32_t>(exponent), 0));
   }
-  if (cells_left != 0 || volumes_left != 0) fail("fewer cells or volumes than the header counts");
+  if (cells_left != 0 || volumes_left != 0)
+    invalidUpdate("fewer cells or volumes than the header counts");
   return body;
 }
 
@@ -218,7 +223,7 @@ std::vector<std::uint8_t> MapUpdateCodec::encode(const Map& map, std::uint64_t s
               kTileRecordBytes * changed.size() + kCellRecordBytes * num_cells +
               kVolumeRecordBytes * num_volumes + kChecksumBytes);
   Writer writer(out);
-  writer.bytes(kMagic, sizeof(kMagic));
+  writer.bytes(kUpdateMagic, sizeof(kUpdateMagic));
   writer.u32(kMapUpdateFormatVersion);
   writer.u32(static_cast<std::uint32_t>(kMapUpdateHeaderBytes));
   writer.f64(map.config_.resolution);
@@ -262,12 +267,12 @@ void MapUpdateCodec::checkFollows(const Map& map, const UpdateHeader& header) {
   if (!(header.config.resolution == map.config_.resolution &&
         header.config.max_coordinate == map.config_.max_coordinate &&
         header.config.rules == map.config_.rules)) {
-    fail("its source's configuration changed (resolution, max_coordinate or rules)");
+    invalidUpdate("its source's configuration changed (resolution, max_coordinate or rules)");
   }
   // Decay only lowers the unit; clear() and rebasing raise it, and make a full update.
   if (header.unit_exponent > map.unit_exponent_ ||
       (header.unit_exponent == map.unit_exponent_ && header.mass_unit > map.mass_unit_)) {
-    fail("the mass unit grew without a full update");
+    invalidUpdate("the mass unit grew without a full update");
   }
 }
 

@@ -11,12 +11,13 @@
 #include <vector>
 
 #include "mvog/depth_image.h"
+#include "test_util.h"
 
 namespace mvog {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+using test::kFloatInf;
+using test::kFloatNaN;
 
 /// fx = 2, fy = 4, cx = 1.5, cy = 0.5: binary fractions, so that 32FC1 points are exact.
 const PinholeCamera kCamera{2.0, 4.0, 1.5, 0.5};
@@ -77,7 +78,8 @@ TEST(BackProjectDepthImage, StartsRaysAtTheCameraAndAppliesItsPose) {
 }
 
 TEST(BackProjectDepthImage, FollowsRep118ForZeroNaNAndInfinities) {
-  const Image<float> image(4, {0.0f, kNaN, -kInf, -1.0f, kInf, 2.0f, -0.0f, kInf});
+  const Image<float> image(4,
+                           {0.0f, kFloatNaN, -kFloatInf, -1.0f, kFloatInf, 2.0f, -0.0f, kFloatInf});
   DepthImageConfig config;
   config.no_return_length = 5.0;
   std::size_t skipped = 0;

@@ -23,6 +23,8 @@ namespace mvog {
 namespace {
 
 using test::allVolumes;
+using test::kFloatInf;
+using test::kFloatNaN;
 using test::totalMass;
 using test::unitConfig;
 using test::volumeIs;
@@ -359,16 +361,14 @@ TEST(Insertion, ResultCountsEveryReadingOnce) {
   InsertionConfig config;
   config.min_range = 0.5;
   config.max_range = 20.0;
-  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  constexpr float kInf = std::numeric_limits<float>::infinity();
   Scan scan;
   scan.origin = {0.5, 0.5, 0.0};
-  scan.hits = {{3, 1, 0},       {-4, 2, 1},      {5, -6, 0},  // obstacles
-               {kNaN, 0, 0},    {0, kInf, 0},                 // non-finite
-               {150, 0, 0},                                   // beyond max_coordinate
-               {0.6f, 0.5f, 0}, {0.5f, 0.5f, 0},              // too close (one of zero length)
-               {30, 0, 0}};                                   // truncated to max_range
-  scan.out_of_range = {{10, 10, 0}, {-10, 3, 2}, {0, 0, -kInf}, {0, -101, 0}, {0.5f, 0.5f, 0}};
+  scan.hits = {{3, 1, 0},         {-4, 2, 1},        {5, -6, 0},  // obstacles
+               {kFloatNaN, 0, 0}, {0, kFloatInf, 0},              // non-finite
+               {150, 0, 0},                                       // beyond max_coordinate
+               {0.6f, 0.5f, 0},   {0.5f, 0.5f, 0},                // too close (one of zero length)
+               {30, 0, 0}};                                       // truncated to max_range
+  scan.out_of_range = {{10, 10, 0}, {-10, 3, 2}, {0, 0, -kFloatInf}, {0, -101, 0}, {0.5f, 0.5f, 0}};
   const InsertionResult result = map.insertScan(scan, config);
   EXPECT_EQ(result.obstacle_readings, 3u);
   EXPECT_EQ(result.out_of_range_readings, 3u);  // two free endpoints and the truncated hit

@@ -24,15 +24,10 @@ namespace {
 
 using Bytes = std::vector<std::uint8_t>;
 using test::allVolumes;
+using test::coarseRandomMap;
+using test::kInf;
+using test::kNaN;
 using test::VolumeRecord;
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-/// A map at resolution 0.2 from random scans in about [-6, 6]^2, default rules.
-Map randomMap(unsigned seed, int num_scans = 3) {
-  return test::randomMap(seed, 0.2, 5.0, num_scans);
-}
 
 /// What forgetting weighs in a list: each volume of a positive list, each run of touching
 /// volumes of a negative one, as (bottom, top, mass summed in double).
@@ -158,7 +153,7 @@ TEST(Forget, ALightRunGoesWholeAndLeavesTheObstacle) {
 
 TEST(Forget, FreesTheTilesOfWhatDecayedAndLeavesTheRestBitForBit) {
   // An old region decayed far below the threshold, a new one seen since.
-  Map map = randomMap(4);
+  Map map = coarseRandomMap(4);
   for (int k = 0; k < 30; ++k) map.decay(0.5);
   std::mt19937 rng(5);
   for (int k = 0; k < 3; ++k)
@@ -193,7 +188,7 @@ TEST(Forget, FreesTheTilesOfWhatDecayedAndLeavesTheRestBitForBit) {
 TEST(Forget, EveryStepOfALongRunLeavesNothingLight) {
   // Insertion writes tiles in place between the steps: what forget remembers of a tile (its
   // lightest mass) must follow, or a light volume would survive a step.
-  Map map = randomMap(6, 1);
+  Map map = coarseRandomMap(6, 1);
   std::mt19937 rng(7);
   const double min_mass = 0.3;
   for (int step = 0; step < 40; ++step) {
@@ -213,7 +208,7 @@ TEST(Forget, EveryStepOfALongRunLeavesNothingLight) {
 }
 
 TEST(Forget, RefusesBadMassesAndZeroForgetsNothing) {
-  Map map = randomMap(8);
+  Map map = coarseRandomMap(8);
   map.decay(1e-3);
   const Bytes bytes = serialized(map);
   for (double bad : {kNaN, -1.0, kInf, -kInf}) {
@@ -299,7 +294,7 @@ TEST(DropTiles, MergingWhatWasDroppedBackGivesTheMapAgain) {
 }
 
 TEST(DropTiles, RefusesBadInputAndDropsNothingWhenAllIsNear) {
-  Map map = randomMap(11);
+  Map map = coarseRandomMap(11);
   const Bytes bytes = serialized(map);
   EXPECT_THROW(map.dropTilesFartherThan({kNaN, 0.0}, 1.0), ConfigError);
   EXPECT_THROW(map.dropTilesFartherThan({0.0, kInf}, 1.0), ConfigError);
@@ -386,7 +381,7 @@ TEST(ClearBox, TheBoxBecomesUnknownTheRestStays) {
 }
 
 TEST(ClearBox, WholeColumnsGoAndTheirTilesAreFreed) {
-  Map map = randomMap(14);
+  Map map = coarseRandomMap(14);
   const MemoryUsage before = map.memoryUsage();
   const std::uint64_t revision = map.revision();
   // x in [-3.2, 0): tiles of 16 cells of 0.2 m, so tiles -1 and -2 in x wholly.
@@ -440,7 +435,7 @@ TEST(ClearBox, AThinBoxClearsALittleMoreThanACellHigh) {
 }
 
 TEST(ClearBox, RefusesNaNEmptyAndInvertedBoxesChangingNothing) {
-  Map map = randomMap(15);
+  Map map = coarseRandomMap(15);
   const Bytes bytes = serialized(map);
   const std::uint64_t revision = map.revision();
   const Eigen::Vector3d low(-1.0, -1.0, -1.0);

@@ -18,15 +18,12 @@ namespace mvog {
 namespace {
 
 using test::allVolumes;
+using test::coarseRandomMap;
+using test::kInf;
+using test::kNaN;
 using test::unitConfig;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-/// A map at resolution 0.2 from random scans in about [-6, 6]^2.
-Map randomMap(unsigned seed) { return test::randomMap(seed, 0.2, 5.0); }
-
-/// Probabilities over the region of randomMap, bit for bit.
+/// Probabilities over the region of coarseRandomMap, bit for bit.
 std::vector<std::uint32_t> probe(const Map& map) { return test::probabilityBits(map, 6.0, 3.0); }
 
 std::size_t countKnown(const std::vector<std::uint32_t>& bits) {
@@ -38,7 +35,7 @@ std::size_t countKnown(const std::vector<std::uint32_t>& bits) {
 // ---- Decay (Sec. III-E) -------------------------------------------------------------------------
 
 TEST(Decay, MultipliesEveryMassByTheFactor) {
-  Map map = randomMap(1);
+  Map map = coarseRandomMap(1);
   const std::vector<CellIndex> cells = test::observedCells(map);
   std::vector<CellVolumes> before;
   for (const CellIndex& cell : cells) before.push_back(map.cellVolumes(cell));
@@ -68,7 +65,7 @@ TEST(Decay, MultipliesEveryMassByTheFactor) {
 TEST(Decay, ProbabilitiesAreUnchangedAfterManySteps) {
   for (double k_d : {0.5, 0.9, 0.999, 1e-10, 1e-300, std::numeric_limits<double>::denorm_min()}) {
     SCOPED_TRACE(::testing::Message() << "k_d = " << k_d);
-    Map map = randomMap(2);
+    Map map = coarseRandomMap(2);
     const std::vector<std::uint32_t> before = probe(map);
     ASSERT_GT(countKnown(before), 1000u);
     for (int step = 0; step < 500; ++step) map.decay(k_d);
@@ -80,7 +77,7 @@ TEST(Decay, ProbabilitiesAreUnchangedAfterManySteps) {
 TEST(Decay, UntouchedCellsKeepTheirProbabilitiesWhileOthersAreUpdated) {
   // Decay steps interleaved with readings elsewhere (x > 25 m): the cells around the origin,
   // which receive no new reading, keep every probability bit for bit.
-  Map map = randomMap(3);
+  Map map = coarseRandomMap(3);
   const std::vector<std::uint32_t> before = probe(map);
   std::mt19937 rng(4);
   for (int step = 0; step < 600; ++step) {
@@ -147,7 +144,7 @@ TEST(Decay, SurvivesDecayBeyondAnyExponentRange) {
   // 20000 steps of the smallest positive double: some 2^24.4 binary orders of decay, beyond what
   // 32-bit exponents hold without rebasing. Probabilities stay bit for bit; readings added in the
   // middle and at the end get the masses of fresh readings.
-  Map map = randomMap(10);
+  Map map = coarseRandomMap(10);
   const std::vector<std::uint32_t> before = probe(map);
   constexpr double kTiny = std::numeric_limits<double>::denorm_min();
   for (int step = 0; step < 10000; ++step) map.decay(kTiny);
@@ -166,7 +163,7 @@ TEST(Decay, SurvivesDecayBeyondAnyExponentRange) {
 }
 
 TEST(Decay, RefusesFactorsOutsideZeroOne) {
-  Map map = randomMap(5);
+  Map map = coarseRandomMap(5);
   const std::vector<test::VolumeRecord> before = allVolumes(map);
   for (double k_d : {0.0, -0.5, 1.0000001, 2.0, kNaN, kInf, -kInf}) {
     try {
@@ -262,7 +259,7 @@ TEST(Map, RejectsNonFiniteReadings) {
 }
 
 TEST(Map, ClearEmptiesTheMapAndResetsDecay) {
-  Map map = randomMap(6);
+  Map map = coarseRandomMap(6);
   map.decay(0.25);
   const std::uint64_t revision = map.revision();
   map.clear();
@@ -277,7 +274,7 @@ TEST(Map, ClearEmptiesTheMapAndResetsDecay) {
 }
 
 TEST(Map, MoveKeepsTheVolumes) {
-  Map map = randomMap(7);
+  Map map = coarseRandomMap(7);
   const std::vector<test::VolumeRecord> before = allVolumes(map);
   Map moved(std::move(map));
   EXPECT_TRUE(test::sameVolumes(allVolumes(moved), before));

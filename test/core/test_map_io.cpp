@@ -30,6 +30,10 @@ namespace {
 
 using Bytes = std::vector<std::uint8_t>;
 using test::allVolumes;
+using test::kFloatInf;
+using test::kFloatNaN;
+using test::kInf;
+using test::kNaN;
 
 // ---- The format written out independently of map_io.cpp ---------------------------------------
 
@@ -481,8 +485,6 @@ TEST(MapIo, RefusesCountsThatDoNotMatchTheSize) {
 }
 
 TEST(MapIo, RefusesBadResolutionOrMaxCoordinate) {
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   for (double resolution : {kNaN, -0.5, 0.0, kInf, -kInf}) {
     EXPECT_TRUE(refused(buildFile(resolution, 100.0, smallCells()))) << resolution;
   }
@@ -492,18 +494,16 @@ TEST(MapIo, RefusesBadResolutionOrMaxCoordinate) {
 }
 
 TEST(MapIo, RefusesCellsBreakingTheConstraints) {
-  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  constexpr float kInf = std::numeric_limits<float>::infinity();
   const std::vector<std::vector<Volume>> bad_lists{{{0, 0.5f, 1}},          // height below 1
                                                    {{1, 0, 1}},             // upside down
                                                    {{0, 2, 1}, {1, 3, 1}},  // overlap
                                                    {{0, 1, 1}, {2, 3, 1}},  // gap of exactly 1
                                                    {{4, 5, 1}, {0, 1, 1}},  // unsorted
                                                    {{0, 1, -1}},            // negative mass
-                                                   {{0, 1, kNaN}},          // NaN mass
-                                                   {{0, 1, kInf}},          // infinite mass
-                                                   {{kNaN, 1, 1}},          // NaN height
-                                                   {{0, kInf, 1}}};         // infinite height
+                                                   {{0, 1, kFloatNaN}},     // NaN mass
+                                                   {{0, 1, kFloatInf}},     // infinite mass
+                                                   {{kFloatNaN, 1, 1}},     // NaN height
+                                                   {{0, kFloatInf, 1}}};    // infinite height
   for (const std::vector<Volume>& list : bad_lists) {
     for (bool positive : {true, false}) {
       std::vector<CellRecord> cells = smallCells();

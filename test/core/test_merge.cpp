@@ -25,9 +25,9 @@ namespace {
 
 using Bytes = std::vector<std::uint8_t>;
 using test::allVolumes;
+using test::kNaN;
 using test::VolumeRecord;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPi = 3.14159265358979323846;
 
 Map copyOf(const Map& map) {

@@ -14,10 +14,9 @@
 namespace mvog {
 namespace {
 
+using test::kInf;
+using test::kNaN;
 using test::unitConfig;
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // ---- occupancy(): eq. (9)
 // ------------------------------------------------------------------------
@@ -183,10 +182,10 @@ TEST(Cells, RectangleHoldsTheCellsOfItsCorners) {
 // -------------------------------------------------------------------------------
 
 /// A map at resolution 0.1 (the default) from random scans around the origin.
-Map randomMap(unsigned seed) { return test::randomMap(seed, 0.1, 3.0); }
+Map fineRandomMap(unsigned seed) { return test::randomMap(seed, 0.1, 3.0); }
 
 TEST(CrossSection, EqualsOccupancyAtCellCentres) {
-  const Map map = randomMap(1);
+  const Map map = fineRandomMap(1);
   // The bounds and a margin of never-observed cells around them.
   const CellRange cells{{map.bounds().min.x - 3, map.bounds().min.y - 2},
                         {map.bounds().max.x + 2, map.bounds().max.y + 3}};
@@ -318,7 +317,7 @@ TEST(Projection, InfiniteBand) {
 TEST(Projection, AgreesWithOccupancySampledOverTheBand) {
   // Where a sample of the band is occupied the projection says occupied; where one is known it
   // is not unknown; where it says unknown every sample is unknown.
-  const Map map = randomMap(2);
+  const Map map = fineRandomMap(2);
   const CellRange cells = map.bounds();
   const double z_min = -0.3;
   const double z_max = 0.4;
@@ -392,7 +391,7 @@ std::vector<test::VolumeRecord> visitedIn(const Map& map, const CellRange& cells
 }
 
 TEST(ForEachVolume, VisitsExactlyEveryVolume) {
-  const Map map = randomMap(3);
+  const Map map = fineRandomMap(3);
   std::vector<test::VolumeRecord> visited = test::allVolumes(map);
   std::sort(visited.begin(), visited.end());
   EXPECT_TRUE(test::sameVolumes(visited, volumesByCell(map, map.bounds())));
@@ -402,7 +401,7 @@ TEST(ForEachVolume, VisitsExactlyEveryVolume) {
 }
 
 TEST(ForEachVolume, RegionRestrictsTheVisit) {
-  const Map map = randomMap(4);
+  const Map map = fineRandomMap(4);
   // Rectangles straddling tiles and the axes, one beyond the data, one empty.
   for (const CellRange& cells :
        {CellRange{{-7, -20}, {13, 2}}, CellRange{{-1, -1}, {0, 0}}, CellRange{{5, 5}, {5, 5}},

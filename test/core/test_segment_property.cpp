@@ -31,7 +31,7 @@
 namespace mvog {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
 
 OccupancyState stateAt(const Map& map, const Eigen::Vector3d& point) {
   return map.occupancy(point).state(kDefaultOccupancyThreshold);

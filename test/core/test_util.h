@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <tuple>
@@ -18,6 +19,11 @@
 
 namespace mvog {
 namespace test {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr float kFloatNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kFloatInf = std::numeric_limits<float>::infinity();
 
 /// A map at resolution 1 (s = 1): grid units are metres, as in the paper's Fig. 3; by default
 /// with the paper's exact model.
@@ -236,6 +242,11 @@ inline Map randomMap(unsigned seed, double resolution, double half_extent, int n
     map.insertScan(randomScan(rng, randomPoint(rng, 1.0, 0.5), 1200, 400, half_extent));
   }
   return map;
+}
+
+/// The random map of the tests of whole maps: resolution 0.2 m, readings within about 6 m.
+inline Map coarseRandomMap(unsigned seed, int num_scans = 3) {
+  return randomMap(seed, 0.2, 5.0, num_scans);
 }
 
 }  // namespace test

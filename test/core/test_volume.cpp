@@ -19,6 +19,8 @@
 namespace mvog {
 namespace {
 
+using test::kFloatInf;
+using test::kFloatNaN;
 using test::satisfiesConstraints;
 using test::volumeIs;
 
@@ -631,8 +633,6 @@ TEST(CheckColumn, AcceptsValidLists) {
 }
 
 TEST(CheckColumn, RefusesEveryViolation) {
-  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  constexpr float kInf = std::numeric_limits<float>::infinity();
   const std::vector<std::vector<Volume>> bad{
       {Volume{0.0f, 0.5f, 0.5f}},                     // height below 1
       {Volume{1.0f, 0.0f, 1.0f}},                     // upside down
@@ -640,11 +640,11 @@ TEST(CheckColumn, RefusesEveryViolation) {
       {fresh(0.0f, 2.0f), fresh(1.0f, 3.0f)},         // overlap
       {fresh(5.0f, 6.0f), fresh(0.0f, 1.0f)},         // unsorted
       {Volume{0.0f, 1.0f, -1.0f}},                    // negative mass
-      {Volume{0.0f, 1.0f, kNaN}},                     // NaN mass
-      {Volume{0.0f, 1.0f, kInf}},                     // infinite mass
-      {Volume{kNaN, 1.0f, 1.0f}},                     // NaN bottom
-      {Volume{0.0f, kInf, 1.0f}},                     // infinite top
-      {Volume{-kInf, 0.0f, 1.0f}},                    // infinite bottom
+      {Volume{0.0f, 1.0f, kFloatNaN}},                // NaN mass
+      {Volume{0.0f, 1.0f, kFloatInf}},                // infinite mass
+      {Volume{kFloatNaN, 1.0f, 1.0f}},                // NaN bottom
+      {Volume{0.0f, kFloatInf, 1.0f}},                // infinite top
+      {Volume{-kFloatInf, 0.0f, 1.0f}},               // infinite bottom
       {fresh(0.0f, 1.0f), Volume{5.0f, 5.5f, 0.5f}},  // second volume too short
   };
   for (const std::vector<Volume>& list : bad) {

@@ -16,14 +16,14 @@
 namespace mvog_ros {
 namespace {
 
-constexpr double kResolution = 0.1;
+constexpr double kGridResolution = 0.1;
 constexpr double kHeight = 1.0;  // m, of the cross-section
 constexpr std::int64_t kTile = mvog::Map::kTileSize;
 constexpr std::int64_t kMarginTiles = 4;  // the layout's margin around the map's tiles
 
 mvog::Map emptyMap() {
   mvog::MapConfig config;
-  config.resolution = kResolution;
+  config.resolution = kGridResolution;
   return mvog::Map(config);
 }
 
@@ -80,8 +80,8 @@ TEST(IncrementalGrid, TheFirstUpdateLaysOutWholeTilesAroundTheMapWithAMargin) {
   const nav_msgs::OccupancyGrid& message = grid.grid();
   EXPECT_EQ(message.info.width, static_cast<std::uint32_t>(cells.width()));
   EXPECT_EQ(message.info.height, static_cast<std::uint32_t>(cells.height()));
-  EXPECT_NEAR(message.info.origin.position.x, cells.min.x * kResolution, 1e-9);
-  EXPECT_NEAR(message.info.origin.position.y, cells.min.y * kResolution, 1e-9);
+  EXPECT_NEAR(message.info.origin.position.x, cells.min.x * kGridResolution, 1e-9);
+  EXPECT_NEAR(message.info.origin.position.y, cells.min.y * kGridResolution, 1e-9);
   EXPECT_EQ(message.info.origin.position.z, kHeight);
   EXPECT_EQ(message.data, expectedData(map, grid));
 }

@@ -21,7 +21,7 @@
 namespace mvog_ros {
 namespace {
 
-const ros::Time kStamp(7.25);
+const ros::Time kMessageStamp(7.25);
 
 /// The fields of a cloud as (name, offset, datatype, count).
 std::vector<std::string> fieldsOf(const sensor_msgs::PointCloud2& cloud) {
@@ -33,10 +33,10 @@ std::vector<std::string> fieldsOf(const sensor_msgs::PointCloud2& cloud) {
   return fields;
 }
 
-/// A well-formed unorganized cloud of `points` points in the map frame at kStamp.
+/// A well-formed unorganized cloud of `points` points in the map frame at kMessageStamp.
 ::testing::AssertionResult isUnorganizedCloud(const sensor_msgs::PointCloud2& cloud,
                                               std::size_t points) {
-  if (cloud.header.frame_id != "map" || cloud.header.stamp != kStamp || cloud.height != 1 ||
+  if (cloud.header.frame_id != "map" || cloud.header.stamp != kMessageStamp || cloud.height != 1 ||
       cloud.width != points || cloud.row_step != cloud.width * cloud.point_step ||
       cloud.data.size() != cloud.row_step || !cloud.is_dense || cloud.is_bigendian) {
     return ::testing::AssertionFailure() << "header or layout: " << cloud.width << " x "
@@ -50,7 +50,7 @@ TEST(FrontierCloud, OnePointPerVoxelWithItsCluster) {
   mvog::Frontiers frontiers;
   frontiers.update(map);
   ASSERT_EQ(frontiers.numClusters(), 2u);  // the door and the unexplored edge
-  const sensor_msgs::PointCloud2 cloud = frontierCloud(frontiers.points(), "map", kStamp);
+  const sensor_msgs::PointCloud2 cloud = frontierCloud(frontiers.points(), "map", kMessageStamp);
   EXPECT_TRUE(isUnorganizedCloud(cloud, frontiers.points().size()));
   EXPECT_EQ(fieldsOf(cloud), (std::vector<std::string>{"x 0 7 1", "y 4 7 1", "z 8 7 1",
                                                        "cluster 12 6 1"}));  // FLOAT32, UINT32
@@ -66,7 +66,7 @@ TEST(FrontierCloud, OnePointPerVoxelWithItsCluster) {
     ASSERT_EQ(*cluster, point.cluster);
     ++x, ++y, ++z, ++cluster;
   }
-  const sensor_msgs::PointCloud2 none = frontierCloud({}, "map", kStamp);
+  const sensor_msgs::PointCloud2 none = frontierCloud({}, "map", kMessageStamp);
   EXPECT_TRUE(isUnorganizedCloud(none, 0));
   EXPECT_EQ(none.fields.size(), 4u);
 }
@@ -75,8 +75,8 @@ TEST(FrontierMarkers, ADeleteAllThenACubeListPerClusterInAColourOfItsOwn) {
   const mvog::Map map = mvog::test::sceneMap();
   mvog::Frontiers frontiers;
   frontiers.update(map);
-  const visualization_msgs::MarkerArray markers =
-      frontierMarkers(frontiers.points(), frontiers.numClusters(), map.resolution(), "map", kStamp);
+  const visualization_msgs::MarkerArray markers = frontierMarkers(
+      frontiers.points(), frontiers.numClusters(), map.resolution(), "map", kMessageStamp);
   ASSERT_EQ(markers.markers.size(), 1u + frontiers.numClusters());
   EXPECT_EQ(markers.markers[0].action, visualization_msgs::Marker::DELETEALL);
   std::size_t points = 0;
@@ -91,7 +91,7 @@ TEST(FrontierMarkers, ADeleteAllThenACubeListPerClusterInAColourOfItsOwn) {
   for (std::uint32_t k = 0; k < frontiers.numClusters(); ++k) {
     const visualization_msgs::Marker& marker = markers.markers[k + 1];
     EXPECT_EQ(marker.header.frame_id, "map");
-    EXPECT_EQ(marker.header.stamp, kStamp);
+    EXPECT_EQ(marker.header.stamp, kMessageStamp);
     EXPECT_EQ(marker.ns, "frontiers");
     EXPECT_EQ(marker.id, static_cast<int>(k));
     EXPECT_EQ(marker.type, visualization_msgs::Marker::CUBE_LIST);
@@ -109,14 +109,14 @@ TEST(FrontierMarkers, ADeleteAllThenACubeListPerClusterInAColourOfItsOwn) {
   EXPECT_EQ(points, frontiers.points().size());
   EXPECT_EQ(colours.size(), frontiers.numClusters());
   // Without frontiers: the DELETEALL alone.
-  EXPECT_EQ(frontierMarkers({}, 0, map.resolution(), "map", kStamp).markers.size(), 1u);
+  EXPECT_EQ(frontierMarkers({}, 0, map.resolution(), "map", kMessageStamp).markers.size(), 1u);
 }
 
 TEST(SurfaceCloud, OnePointPerSurfaceWithItsClearanceAndProbability) {
   const mvog::Map map = mvog::test::sceneMap();
   mvog::Surfaces surfaces;
   surfaces.update(map);
-  const sensor_msgs::PointCloud2 cloud = surfaceCloud(surfaces.surfaces(), "map", kStamp);
+  const sensor_msgs::PointCloud2 cloud = surfaceCloud(surfaces.surfaces(), "map", kMessageStamp);
   EXPECT_TRUE(isUnorganizedCloud(cloud, surfaces.surfaces().size()));
   EXPECT_EQ(fieldsOf(cloud), (std::vector<std::string>{"x 0 7 1", "y 4 7 1", "z 8 7 1",
                                                        "clearance 12 7 1", "probability 16 7 1"}));
@@ -131,7 +131,7 @@ TEST(SurfaceCloud, OnePointPerSurfaceWithItsClearanceAndProbability) {
     ASSERT_EQ(*probability, surface.probability);
     ++x, ++z, ++clearance, ++probability;
   }
-  EXPECT_TRUE(isUnorganizedCloud(surfaceCloud({}, "map", kStamp), 0));
+  EXPECT_TRUE(isUnorganizedCloud(surfaceCloud({}, "map", kMessageStamp), 0));
 }
 
 mvog::PlanningConfig tallRobot() {

@@ -18,14 +18,14 @@
 namespace mvog_ros {
 namespace {
 
-constexpr double kResolution = 0.1;
-const ros::Time kStamp(12.5);
+constexpr double kMapResolution = 0.1;
+const ros::Time kMarkerStamp(12.5);
 
 /// One obstacle reading along x at z = 1 m: free space in cells 0..9 of row 0, and a hit in cell
 /// (10, 0), whose positive volume spans [9.5, 10.5] grid units (eq. 6), i.e. [0.95, 1.05] m.
 mvog::Map oneReadingMap() {
   mvog::MapConfig config;
-  config.resolution = kResolution;
+  config.resolution = kMapResolution;
   mvog::Map map(config);
   map.insertReading({0.05, 0.05, 1.0}, {1.05, 0.05, 1.0}, mvog::ReadingKind::kObstacle);
   return map;
@@ -67,14 +67,14 @@ std::size_t volumesIn(const mvog::Map& map, const mvog::TileIndex& tile, mvog::V
 TEST(VolumeMarkers, OneTriangleListPerSignWithTwelveTrianglesPerVolume) {
   const mvog::Map map = oneReadingMap();
   visualization_msgs::MarkerArray markers;
-  appendVolumeMarkers(map, {0, 0}, "map", kStamp, markers);
+  appendVolumeMarkers(map, {0, 0}, "map", kMarkerStamp, markers);
   ASSERT_EQ(markers.markers.size(), 2u);
   for (const char* ns : {"positive", "negative"}) {
     const std::vector<visualization_msgs::Marker> found = markersOf(markers, ns);
     ASSERT_EQ(found.size(), 1u) << ns;
     const visualization_msgs::Marker& marker = found[0];
     EXPECT_EQ(marker.header.frame_id, "map");
-    EXPECT_EQ(marker.header.stamp, kStamp);
+    EXPECT_EQ(marker.header.stamp, kMarkerStamp);
     EXPECT_EQ(marker.id, tileMarkerId({0, 0}));
     EXPECT_EQ(marker.type, visualization_msgs::Marker::TRIANGLE_LIST);
     EXPECT_EQ(marker.action, visualization_msgs::Marker::ADD);
@@ -91,7 +91,7 @@ TEST(VolumeMarkers, OneTriangleListPerSignWithTwelveTrianglesPerVolume) {
 TEST(VolumeMarkers, TheHitIsABoxOverItsCellAtTheHeightsOfItsVolume) {
   const mvog::Map map = oneReadingMap();
   visualization_msgs::MarkerArray markers;
-  appendVolumeMarkers(map, {0, 0}, "map", kStamp, markers);
+  appendVolumeMarkers(map, {0, 0}, "map", kMarkerStamp, markers);
   const visualization_msgs::Marker positive = markersOf(markers, "positive").at(0);
   ASSERT_EQ(positive.points.size(), 36u);
   const Extent box = extentOf(positive.points);
@@ -110,7 +110,7 @@ TEST(VolumeMarkers, TheHitIsABoxOverItsCellAtTheHeightsOfItsVolume) {
 TEST(VolumeMarkers, ATileWithoutVolumesDeletesItsMarkers) {
   const mvog::Map map = oneReadingMap();
   visualization_msgs::MarkerArray markers;
-  appendVolumeMarkers(map, {5, -7}, "map", kStamp, markers);
+  appendVolumeMarkers(map, {5, -7}, "map", kMarkerStamp, markers);
   ASSERT_EQ(markers.markers.size(), 2u);
   for (const visualization_msgs::Marker& marker : markers.markers) {
     EXPECT_EQ(marker.action, visualization_msgs::Marker::DELETE) << marker.ns;
@@ -122,7 +122,7 @@ TEST(VolumeMarkers, ATileWithoutVolumesDeletesItsMarkers) {
 TEST(OccupiedMarkers, BoxesWhereTheProbabilityExceedsTheThresholdColouredByHeight) {
   const mvog::Map map = oneReadingMap();
   visualization_msgs::MarkerArray markers;
-  appendOccupiedMarkers(map, {0, 0}, 0.5, "map", kStamp, markers);
+  appendOccupiedMarkers(map, {0, 0}, 0.5, "map", kMarkerStamp, markers);
   ASSERT_EQ(markers.markers.size(), 1u);
   const visualization_msgs::Marker& occupied = markers.markers[0];
   EXPECT_EQ(occupied.ns, "occupied");
@@ -144,11 +144,11 @@ TEST(OccupiedMarkers, BoxesWhereTheProbabilityExceedsTheThresholdColouredByHeigh
 
 TEST(OccupiedMarkers, NothingAboveACertainThresholdIsADelete) {
   visualization_msgs::MarkerArray markers;
-  appendOccupiedMarkers(oneReadingMap(), {0, 0}, 0.9999999, "map", kStamp, markers);
+  appendOccupiedMarkers(oneReadingMap(), {0, 0}, 0.9999999, "map", kMarkerStamp, markers);
   ASSERT_EQ(markers.markers.size(), 1u);
   EXPECT_EQ(markers.markers[0].action, visualization_msgs::Marker::ADD);  // p = 1 at the hit
   markers.markers.clear();
-  appendOccupiedMarkers(oneReadingMap(), {1, 0}, 0.5, "map", kStamp, markers);
+  appendOccupiedMarkers(oneReadingMap(), {1, 0}, 0.5, "map", kMarkerStamp, markers);
   ASSERT_EQ(markers.markers.size(), 1u);
   EXPECT_EQ(markers.markers[0].action, visualization_msgs::Marker::DELETE);
 }
@@ -163,10 +163,10 @@ TEST(TileMarkerId, NeighbouringAndNegativeTilesHaveDistinctIds) {
 }
 
 TEST(DeleteAllMarker, ClearsTheTopicInTheMapFrame) {
-  const visualization_msgs::Marker marker = deleteAllMarker("world", kStamp);
+  const visualization_msgs::Marker marker = deleteAllMarker("world", kMarkerStamp);
   EXPECT_EQ(marker.action, visualization_msgs::Marker::DELETEALL);
   EXPECT_EQ(marker.header.frame_id, "world");
-  EXPECT_EQ(marker.header.stamp, kStamp);
+  EXPECT_EQ(marker.header.stamp, kMarkerStamp);
   EXPECT_EQ(marker.pose.orientation.w, 1.0);
 }
 
@@ -186,12 +186,12 @@ TEST(ToOccupancyGrid, KeepsTheGridsCellsOriginAndHeight) {
   const mvog::Map map = oneReadingMap();
   const mvog::CellRange cells{{-2, -1}, {12, 1}};
   const mvog::CrossSection section = map.crossSection(1.0, cells);
-  const nav_msgs::OccupancyGrid grid = toOccupancyGrid(section, 1.0, "map", kStamp);
+  const nav_msgs::OccupancyGrid grid = toOccupancyGrid(section, 1.0, "map", kMarkerStamp);
   EXPECT_EQ(grid.header.frame_id, "map");
-  EXPECT_EQ(grid.header.stamp, kStamp);
+  EXPECT_EQ(grid.header.stamp, kMarkerStamp);
   EXPECT_EQ(grid.info.width, 15u);
   EXPECT_EQ(grid.info.height, 3u);
-  EXPECT_FLOAT_EQ(grid.info.resolution, static_cast<float>(kResolution));
+  EXPECT_FLOAT_EQ(grid.info.resolution, static_cast<float>(kMapResolution));
   EXPECT_NEAR(grid.info.origin.position.x, -0.2, 1e-9);
   EXPECT_NEAR(grid.info.origin.position.y, -0.1, 1e-9);
   EXPECT_EQ(grid.info.origin.position.z, 1.0);
