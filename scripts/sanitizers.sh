@@ -35,6 +35,10 @@ fail() {
   failures+=("$1")
 }
 
+# Every build here is CMake's unity build, each target's sources compiled as one file: the ROS and
+# gtest headers parsed once a target instead of once a source (and the rule of CMakeLists.txt
+# checked, that no two sources of a target define one name in an anonymous namespace).
+unity_build_flags=(-DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=0)
 # Every build here uses Ninja: given several targets, CMake's Makefiles build them one after the
 # other (their top-level Makefile is .NOTPARALLEL), a single-file program on one core of two;
 # Ninja builds them side by side.
@@ -55,7 +59,7 @@ build() {
   quietly "sanitizer-$mode-configure" env CXX="$compiler" cmake -G Ninja \
     -S "$REPO/test/sanitizers" -B "$BUILD_ROOT/$mode" -DMVOG_SANITIZER="$mode" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 \
-    -DCMAKE_UNITY_BUILD=ON &&
+    "${unity_build_flags[@]}" &&
     quietly "sanitizer-$mode-build" cmake --build "$BUILD_ROOT/$mode" -j2 --target "$@"
 }
 
@@ -92,9 +96,8 @@ fuzz_targets=(map_file map_update conversions)
 # nodelet manager; not the replays of ../shared/data: minutes each). -O1 as ASan's authors
 # advise: less compile time than -O2 for the same checks; -g1: the line tables a report's stack
 # trace needs (file:line), without -g's variable descriptions (less to compile and link); a unity
-# build, as every build of this script (CMAKE_UNITY_BUILD: the ROS and gtest headers parsed once
-# a batch of sources instead of once a file). A sanitizer report by any process fails the check
-# and is appended to its log.
+# build, as every build of this script (unity_build_flags). A sanitizer report by any process
+# fails the check and is appended to its log.
 asan_workspace=$BUILD_ROOT/catkin
 sanitize="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all"
 # in_asan_workspace NAME COMMAND...: runs COMMAND with the instrumented workspace sourced, its
@@ -134,7 +137,7 @@ if (cd "$asan_workspace" && quietly sanitizer-catkin-build catkin_make --use-nin
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DCMAKE_CXX_FLAGS="$sanitize -fno-omit-frame-pointer" -DCMAKE_EXE_LINKER_FLAGS="$sanitize" \
   -DCMAKE_SHARED_LINKER_FLAGS="$sanitize" -DCATKIN_ENABLE_TESTING=ON -DMVOG_FUZZ_TARGETS=replay \
-  -DCMAKE_UNITY_BUILD=ON \
+  "${unity_build_flags[@]}" \
   -j2 mvog_node test_mapper_node test_planning_node mvog_generate_messages "${asan_programs[@]}" \
   "${fuzz_targets[@]/#/fuzz_replay_}"); then
   asan_built=true

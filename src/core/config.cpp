@@ -2,14 +2,11 @@
 
 #include <cmath>
 
+#include "config_checks.h"
+
 namespace mvog {
-namespace {
 
-void require(bool condition, const char* field, const char* reason) {
-  if (!condition) throw ConfigError(std::string(field) + ": " + reason);
-}
-
-}  // namespace
+using detail::require;
 
 void MapConfig::validate() const {
   require(std::isfinite(resolution) && resolution > 0.0, "resolution",

@@ -5,27 +5,30 @@
 #include <cstring>
 #include <string>
 
+#include "config_checks.h"
+
 namespace mvog {
 namespace {
 
+using detail::invalidField;
+using detail::require;
+
 /// Millimetres to metres, in float as depth_image_proc converts them (DepthTraits<uint16_t>).
 constexpr float kMetresPerMillimetre = 0.001f;
-
-void require(bool condition, const char* field, const std::string& reason) {
-  if (!condition) throw ConfigError(std::string(field) + ": " + reason);
-}
 
 }  // namespace
 
 void DepthImageView::validate() const {
   const std::size_t row_bytes = std::size_t{width} * bytesPerPixel(encoding);
-  require(step >= row_bytes, "step",
-          std::to_string(step) + " bytes is less than width x bytes per pixel (" +
-              std::to_string(row_bytes) + ")");
+  if (step < row_bytes) {
+    invalidField("step", std::to_string(step) + " bytes is less than width x bytes per pixel (" +
+                             std::to_string(row_bytes) + ")");
+  }
   // height x step <= size, without overflow.
-  require(height == 0 || step <= size / height, "size",
-          std::to_string(size) + " bytes is less than height x step (" + std::to_string(height) +
-              " x " + std::to_string(step) + ")");
+  if (height != 0 && step > size / height) {
+    invalidField("size", std::to_string(size) + " bytes is less than height x step (" +
+                             std::to_string(height) + " x " + std::to_string(step) + ")");
+  }
   require(data != nullptr || size == 0, "data", "is null");
 }
 

@@ -85,8 +85,9 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
     invalidMap("truncated: " + std::to_string(size) +
                " bytes is less than a header and a checksum");
   }
-  if (std::memcmp(data, kMapFileMagic, sizeof(kMapFileMagic)) != 0)
+  if (std::memcmp(data, kMapFileMagic, sizeof(kMapFileMagic)) != 0) {
     invalidMap("not an MVOG map (bad magic)");
+  }
   Reader header(data, sizeof(kMapFileMagic));
   const std::uint32_t version = header.u32();
   if (version != kMapFormatVersion && version != 1) {

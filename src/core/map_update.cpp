@@ -50,8 +50,9 @@ UpdateHeader readHeader(const std::uint8_t* data, std::size_t size) {
     invalidUpdate("truncated: " + std::to_string(size) +
                   " bytes is less than a header and a checksum");
   }
-  if (std::memcmp(data, kUpdateMagic, sizeof(kUpdateMagic)) != 0)
+  if (std::memcmp(data, kUpdateMagic, sizeof(kUpdateMagic)) != 0) {
     invalidUpdate("not an MVOG map update (bad magic)");
+  }
   detail::Reader reader(data, sizeof(kUpdateMagic));
   const std::uint32_t version = reader.u32();
   if (version != kMapUpdateFormatVersion) {
@@ -98,13 +99,15 @@ UpdateHeader readHeader(const std::uint8_t* data, std::size_t size) {
   } catch (const ConfigError& e) {
     invalidUpdate(std::string("bad header: ") + e.what());
   }
-  if (info.from_revision > info.to_revision)
+  if (info.from_revision > info.to_revision) {
     invalidUpdate("the from revision is after the to revision");
+  }
   if (info.full && (info.from_revision != 0 || num_removed != 0)) {
     invalidUpdate("a full update with a from revision or removed tiles");
   }
-  if (!(header.mass_unit > 0.5 && header.mass_unit <= 1.0))
+  if (!(header.mass_unit > 0.5 && header.mass_unit <= 1.0)) {
     invalidUpdate("mass unit not in (0.5, 1]");
+  }
   if (header.unit_exponent < detail::kMinUnitExponent || header.unit_exponent > 0) {
     invalidUpdate("unit exponent not in [-2^24, 0]");
   }
@@ -180,8 +183,9 @@ UpdateBody readBody(const std::uint8_t* data, const UpdateHeader& header) {
     }
     body.tiles.emplace_back(key, builder.finish(static_cast<std::int32_t>(exponent), 0));
   }
-  if (cells_left != 0 || volumes_left != 0)
+  if (cells_left != 0 || volumes_left != 0) {
     invalidUpdate("fewer cells or volumes than the header counts");
+  }
   return body;
 }
 

@@ -3,12 +3,12 @@
 #include <cmath>
 #include <string>
 
+#include "config_checks.h"
+
 namespace mvog {
 namespace {
 
-void require(bool condition, const char* field, const char* reason) {
-  if (!condition) throw ConfigError(std::string(field) + ": " + reason);
-}
+using detail::require;
 
 /// A band [min, max] of heights: not NaN, min <= max, infinite bounds allowed.
 void requireBand(double min, double max, const char* min_field) {

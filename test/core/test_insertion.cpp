@@ -507,26 +507,30 @@ TEST(Insertion, NewVolumesBesideAColumnsVolumesAreMergedAsTheRulesSay) {
     float z1;
     ReadingKind kind;
   };
-  constexpr ReadingKind kFree = ReadingKind::kOutOfRange;
+  constexpr ReadingKind kFreeReading = ReadingKind::kOutOfRange;
   constexpr ReadingKind kHit = ReadingKind::kObstacle;
   const CellVolumes pieces{{{3, 4, 1}}, {{1, 3, 2}, {3, 4, 1}, {4, 6, 2}}};
   const std::vector<Case> cases{
-      {"grows a volume upwards", {{}, {{0, 2, 3}}}, 1.5f, 4.0f, kFree},
-      {"across a gap below", {{}, {{2, 4, 3}}}, 0.25f, 1.5f, kFree},
-      {"across a gap above", {{}, {{2, 4, 3}}}, 4.5f, 6.0f, kFree},
-      {"past both ends of a volume", {{}, {{2, 4, 3}}}, 1.0f, 5.0f, kFree},
-      {"bridges two runs", {{}, {{0, 2, 2}, {3.5f, 5, 1.5f}}}, 2.25f, 3.25f, kFree},
-      {"across a gap up to the next run", {{}, {{0, 2, 2}, {4, 5, 1}}}, 2.5f, 3.5f, kFree},
-      {"grows the piece below an obstacle", pieces, 0.0f, 2.5f, kFree},
-      {"grows the piece above an obstacle", pieces, 5.0f, 7.5f, kFree},
-      {"past both ends of a run of pieces", pieces, -1.0f, 8.0f, kFree},
-      {"into the next piece from below", pieces, -0.5f, 3.5f, kFree},
-      {"into the next piece from above", pieces, 3.5f, 7.0f, kFree},
-      {"grows an obstacle's piece", {{{0, 1, 1}}, {{0, 1, 1}, {1, 3, 2}}}, -2.0f, 0.5f, kFree},
-      {"over an obstacle beyond the run", {{{5, 6, 1}}, {{1, 3, 2}}}, 2.0f, 5.5f, kFree},
-      {"across an obstacle", {{{2, 3, 1}}, {}}, 0.0f, 5.0f, kFree},
-      {"from an obstacle's top", {{{0, 1, 1}}, {}}, 1.0f, 4.0f, kFree},
-      {"a little more than a gap above", {{{0, 1, 1}}, {{1, 3, 2}}}, 4.25f, 6.0f, kFree},
+      {"grows a volume upwards", {{}, {{0, 2, 3}}}, 1.5f, 4.0f, kFreeReading},
+      {"across a gap below", {{}, {{2, 4, 3}}}, 0.25f, 1.5f, kFreeReading},
+      {"across a gap above", {{}, {{2, 4, 3}}}, 4.5f, 6.0f, kFreeReading},
+      {"past both ends of a volume", {{}, {{2, 4, 3}}}, 1.0f, 5.0f, kFreeReading},
+      {"bridges two runs", {{}, {{0, 2, 2}, {3.5f, 5, 1.5f}}}, 2.25f, 3.25f, kFreeReading},
+      {"across a gap up to the next run", {{}, {{0, 2, 2}, {4, 5, 1}}}, 2.5f, 3.5f, kFreeReading},
+      {"grows the piece below an obstacle", pieces, 0.0f, 2.5f, kFreeReading},
+      {"grows the piece above an obstacle", pieces, 5.0f, 7.5f, kFreeReading},
+      {"past both ends of a run of pieces", pieces, -1.0f, 8.0f, kFreeReading},
+      {"into the next piece from below", pieces, -0.5f, 3.5f, kFreeReading},
+      {"into the next piece from above", pieces, 3.5f, 7.0f, kFreeReading},
+      {"grows an obstacle's piece",
+       {{{0, 1, 1}}, {{0, 1, 1}, {1, 3, 2}}},
+       -2.0f,
+       0.5f,
+       kFreeReading},
+      {"over an obstacle beyond the run", {{{5, 6, 1}}, {{1, 3, 2}}}, 2.0f, 5.5f, kFreeReading},
+      {"across an obstacle", {{{2, 3, 1}}, {}}, 0.0f, 5.0f, kFreeReading},
+      {"from an obstacle's top", {{{0, 1, 1}}, {}}, 1.0f, 4.0f, kFreeReading},
+      {"a little more than a gap above", {{{0, 1, 1}}, {{1, 3, 2}}}, 4.25f, 6.0f, kFreeReading},
       {"a hit near an obstacle", {{{2, 3, 1}}, {}}, 8.0f, 4.25f, kHit},
       {"a hit on an obstacle's top", {{{2, 3, 1}}, {}}, 8.0f, 3.5f, kHit},
       {"a hit a little more than a gap away", {{{2, 3, 1}}, {}}, 8.0f, 4.75f, kHit},

@@ -30,24 +30,15 @@ namespace {
 
 using Bytes = std::vector<std::uint8_t>;
 using test::allVolumes;
+using test::fixChecksum;
 using test::kFloatInf;
 using test::kFloatNaN;
 using test::kInf;
 using test::kNaN;
+using test::putLe;
 
 // ---- The format written out independently of map_io.cpp ---------------------------------------
 
-std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
-  std::uint64_t hash = 0xcbf29ce484222325ull;
-  for (std::size_t k = 0; k < size; ++k) {
-    hash = (hash ^ data[k]) * 0x100000001b3ull;
-  }
-  return hash;
-}
-
-void putLe(Bytes& out, std::size_t offset, std::uint64_t value, int size) {
-  for (int k = 0; k < size; ++k) out[offset + k] = static_cast<std::uint8_t>(value >> (8 * k));
-}
 void appendLe(Bytes& out, std::uint64_t value, int size) {
   out.resize(out.size() + size);
   putLe(out, out.size() - size, value, size);
@@ -79,11 +70,6 @@ struct CellRecord {
   std::vector<Volume> positive;
   std::vector<Volume> negative;
 };
-
-/// Rewrites the checksum (the last 8 bytes) to match the bytes before it.
-void fixChecksum(Bytes& file) {
-  putLe(file, file.size() - 8, fnv1a64(file.data(), file.size() - 8), 8);
-}
 
 /// A file in the documented layout, with the counts and the checksum filled in.
 /// The documented layout, written by hand: version 2 with the rules' bits (0b111 for the defaults:

@@ -18,6 +18,9 @@ namespace mvog {
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
+using test::fixChecksum;
+using test::fnv1a64;
+using test::putLe;
 
 Bytes updateOf(const Map& map, std::uint64_t since) { return serializeMapUpdate(map, since); }
 
@@ -281,17 +284,6 @@ double readDouble(const Bytes& bytes, std::size_t offset) {
   std::memcpy(&value, &bits, 8);
   return value;
 }
-std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
-  std::uint64_t hash = 0xcbf29ce484222325ull;
-  for (std::size_t k = 0; k < size; ++k) hash = (hash ^ data[k]) * 0x100000001b3ull;
-  return hash;
-}
-void writeLe(Bytes& bytes, std::size_t offset, std::uint64_t value, int size) {
-  for (int k = 0; k < size; ++k) bytes[offset + k] = static_cast<std::uint8_t>(value >> (8 * k));
-}
-void fixChecksum(Bytes& bytes) {
-  writeLe(bytes, bytes.size() - 8, fnv1a64(bytes.data(), bytes.size() - 8), 8);
-}
 
 /// A small source: cells in tiles (0, 0), (1, 0) and (-1, 2), then (1, 0) emptied and a cell of
 /// (0, 0) changed; `since` is the revision before those two changes.
@@ -368,8 +360,8 @@ struct Synced {
                              {{-3, 40}, {{{0, 2, 2}}, {}}}});
     Bytes full = updateOf(at_since, 0);
     update = updateOf(small.source, small.since);
-    writeLe(full, 48, readLe(update, 48, 8), 8);  // the source's id
-    writeLe(full, 64, small.since, 8);            // at the source's revision
+    putLe(full, 48, readLe(update, 48, 8), 8);  // the source's id
+    putLe(full, 64, small.since, 8);            // at the source's revision
     fixChecksum(full);
     EXPECT_EQ(applyTo(mirror, full).status, MapUpdateStatus::kApplied);
     mirrored = serializeMap(mirror.map());
@@ -392,7 +384,7 @@ TEST(MapUpdate, AFreeListAcrossAnObstacleIsStoredAsTheMergeCutsIt) {
   Map source(test::unitConfig(1000.0, ModelRules::paper()));
   source.setCellVolumes({3, 4}, CellVolumes{{{2, 3, 1}}, {{0, 10, 5}}});
   Bytes full = updateOf(source, 0);
-  writeLe(full, 32, readLe(full, 32, 4) | 4u, 4);  // bit 2: split_free_space_at_obstacles
+  putLe(full, 32, readLe(full, 32, 4) | 4u, 4);  // bit 2: split_free_space_at_obstacles
   fixChecksum(full);
   MapMirror mirror;
   ASSERT_EQ(applyTo(mirror, full).status, MapUpdateStatus::kApplied);
@@ -441,7 +433,7 @@ TEST(MapUpdate, RefusesCorruptOrForeignBytesChangingNothing) {
   // Consistent checksums over inconsistent contents.
   auto patched = [&](std::size_t offset, std::uint64_t value, int size) {
     Bytes bytes = update;
-    writeLe(bytes, offset, value, size);
+    putLe(bytes, offset, value, size);
     fixChecksum(bytes);
     return bytes;
   };
@@ -490,8 +482,8 @@ TEST(MapUpdate, RefusesCorruptOrForeignBytesChangingNothing) {
   Bytes decayed = updateOf(small.source, before_decay);
   ASSERT_EQ(applyTo(synced.mirror, synced.update).status, MapUpdateStatus::kApplied);
   ASSERT_EQ(applyTo(synced.mirror, decayed).status, MapUpdateStatus::kApplied);
-  writeLe(decayed, 80, readLe(update, 80, 8), 8);  // the unit exponent before the decay step
-  writeLe(decayed, 56, small.source.revision(), 8);
+  putLe(decayed, 80, readLe(update, 80, 8), 8);  // the unit exponent before the decay step
+  putLe(decayed, 56, small.source.revision(), 8);
   fixChecksum(decayed);
   const Bytes now = serializeMap(synced.mirror.map());
   EXPECT_THROW(applyTo(synced.mirror, decayed), MapFileError);

@@ -25,6 +25,26 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr float kFloatNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kFloatInf = std::numeric_limits<float>::infinity();
 
+// ---- The byte formats (map files, map updates), written independently of the core ----------
+
+/// FNV-1a, 64 bits: the checksum that ends a map file and a map update.
+inline std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
+  std::uint64_t hash = 0xcbf29ce484222325ull;
+  for (std::size_t k = 0; k < size; ++k) hash = (hash ^ data[k]) * 0x100000001b3ull;
+  return hash;
+}
+
+/// Writes the `size` low bytes of `value` at `offset`, little-endian.
+inline void putLe(std::vector<std::uint8_t>& bytes, std::size_t offset, std::uint64_t value,
+                  int size) {
+  for (int k = 0; k < size; ++k) bytes[offset + k] = static_cast<std::uint8_t>(value >> (8 * k));
+}
+
+/// Rewrites the checksum (the last 8 bytes) to match the bytes before it.
+inline void fixChecksum(std::vector<std::uint8_t>& bytes) {
+  putLe(bytes, bytes.size() - 8, fnv1a64(bytes.data(), bytes.size() - 8), 8);
+}
+
 /// A map at resolution 1 (s = 1): grid units are metres, as in the paper's Fig. 3; by default
 /// with the paper's exact model.
 inline MapConfig unitConfig(double max_coordinate = 10000.0,

@@ -4,12 +4,18 @@
 #include <optional>
 #include <string>
 
+#include <geometry_msgs/Point.h>
 #include <tf2_ros/buffer.h>
 #include <Eigen/Geometry>
 
 namespace mvog_ros {
 
-// What the query services (QueryServices, PlanningServices) check of every request.
+// What the services that take points (QueryServices, PlanningServices, MapEditServices) share.
+
+/// A point of a request, as the core takes it.
+inline Eigen::Vector3d toEigen(const geometry_msgs::Point& point) {
+  return {point.x, point.y, point.z};
+}
 
 /// Whether a request of `count` points (segments, boxes: `what`) is within ~max_query_points;
 /// if not, `refusal` says so.

@@ -11,6 +11,7 @@
 #include "mvog/map_io.h"
 #include "mvog_ros/frames.h"
 #include "mvog_ros/map_paths.h"
+#include "mvog_ros/services/query_requests.h"
 
 namespace mvog_ros {
 namespace {
@@ -18,8 +19,6 @@ namespace {
 /// How far from 1 the norm of map_from_other's quaternion may be (typed in with 4 decimals, 90
 /// degrees is (0, 0, 0.7071, 0.7071)): it is normalised, and the grid check that follows is exact.
 constexpr double kQuaternionNormTolerance = 1e-3;
-
-Eigen::Vector3d toEigen(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
 
 /// The axis-aligned box of the map frame that holds the 8 corners of the box [min, max] of a frame
 /// at `map_from_frame`. Throws mvog::ConfigError for a box that is not finite or not ordered: an

@@ -8,8 +8,6 @@
 namespace mvog_ros {
 namespace {
 
-Eigen::Vector3d toEigen(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
-
 /// A refusal of the core (mvog::ConfigError) as a message; the core names max_query_cells as
 /// the field, which is the parameter ~max_query_cells.
 std::string refusalOf(const mvog::ConfigError& e) {
