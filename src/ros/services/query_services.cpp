@@ -37,9 +37,8 @@ bool QueryServices::getOccupancy(mvog::GetOccupancy::Request& request,
   response.state.resize(request.points.size());
   std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
   for (std::size_t k = 0; k < request.points.size(); ++k) {
-    const geometry_msgs::Point& p = request.points[k];
     const mvog::PointOccupancy occupancy =
-        map_.map.occupancy(*map_from_frame * Eigen::Vector3d(p.x, p.y, p.z));
+        map_.map.occupancy(*map_from_frame * toEigen(request.points[k]));
     response.probability[k] = occupancy.probability.value_or(std::nanf(""));
     response.state[k] = static_cast<std::uint8_t>(occupancy.state(occupancy_threshold_));
   }
