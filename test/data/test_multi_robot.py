@@ -24,7 +24,7 @@ from rosgraph_msgs.msg import Clock
 from std_srvs.srv import SetBool
 
 import mvog_data_test as data
-from mvog.msg import MapStatistics
+from mvog.msg import MapBinary, MapStatistics
 from mvog.srv import GetOccupancy
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lifecycle"))
@@ -39,6 +39,7 @@ MIRRORS = ["/base/robot1/mvog_mirror", "/base/robot2/mvog_mirror"]
 MERGED, WHOLE = "/base/mvog_merged", "/whole/mvog_mapper"
 LASER_HEIGHT = 0.3  # the data README's (synthetic) mount height
 SAMPLES = 40000
+MERGE_PERIOD = 2.0  # s of the clock: multi_robot.test's merge_period
 
 
 def states(ns, points):
@@ -96,6 +97,11 @@ class MultiRobot(data.DataTestCase):
         for ns in ROBOTS + [WHOLE]:
             rospy.Subscriber(ns + "/statistics", MapStatistics, cls._on_statistics,
                              callback_args=ns)
+        # What the merger merges: each mirror's ~map, published every ~binary_map_period (5 s by
+        # default) when it changed, so up to a period after the mirror holds its robot's map.
+        cls.published = {}
+        for ns in MIRRORS:
+            rospy.Subscriber(ns + "/map", MapBinary, cls._on_map, callback_args=ns)
         # Each half's topic has two subscribers: its robot and /whole.
         play = ["rosbag", "play", "--clock", "-q", "-r", str(RATE), str(path)]
         started = time.time()
@@ -106,10 +112,12 @@ class MultiRobot(data.DataTestCase):
         cls.play_seconds = time.time() - started
 
         # The clock on past the bag's end until each map holds every scan, each mirror is its
-        # robot's map, and the merged map has not changed over two merge periods.
+        # robot's map and has published it to the merger, and the merged map has not changed over
+        # two merge periods since then. (Waiting only for the merged map to stay unchanged raced
+        # with the mirrors' publications: a run merged a mirror's map of a few scans before.)
         clock = rospy.Publisher("/clock", Clock, queue_size=10)
         now, deadline = end, time.time() + 180.0
-        previous, stable_since = None, None
+        previous, stable_since, inputs_final_since = None, None, None
         waiting_for = "every scan counted"
         while True:
             assert time.time() < deadline, "the maps did not settle, waiting for %s: %s" % (
@@ -124,10 +132,16 @@ class MultiRobot(data.DataTestCase):
             snapshots = {ns: node.snapshot() for ns, node in cls.nodes.items()}
             if any(snapshots[m] != snapshots[r] for m, r in zip(MIRRORS, ROBOTS)):
                 continue
+            waiting_for = "each mirror to publish its map to the merger"
+            if any(cls.published.get(m) != snapshots[m] for m in MIRRORS):
+                inputs_final_since = None
+                continue
+            if inputs_final_since is None:
+                inputs_final_since = now
             waiting_for = "the merged map to stay unchanged"
             if snapshots[MERGED] != previous:
                 previous, stable_since = snapshots[MERGED], now
-            elif now - stable_since >= 4.0:
+            elif now - max(stable_since, inputs_final_since) >= 2 * MERGE_PERIOD:
                 break
         cls.snapshots = snapshots
         print("halves of %d and %d scans played in %.1f s; settled at %.1f s of the clock past "
@@ -140,6 +154,10 @@ class MultiRobot(data.DataTestCase):
     @classmethod
     def _on_statistics(cls, message, ns):
         cls.statistics[ns] = message
+
+    @classmethod
+    def _on_map(cls, message, ns):
+        cls.published[ns] = bytes(message.data)
 
     @classmethod
     def all_inserted(cls):
