@@ -14,7 +14,8 @@ class TransformUnavailable : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The latest transform from `frame` into `map_frame`, waiting up to `timeout` s for it. Throws
+/// The latest transform from `frame` into `map_frame`, waiting up to `timeout` s of wall time for
+/// it (ROS time may stand still: a replayed bag over). Throws
 /// TransformUnavailable: "cannot transform from 'FRAME' to 'MAP_FRAME': why".
 Eigen::Isometry3d latestTransform(const tf2_ros::Buffer& tf_buffer, const std::string& map_frame,
                                   const std::string& frame, double timeout);

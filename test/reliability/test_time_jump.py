@@ -105,6 +105,22 @@ class TimeJump(unittest.TestCase):
             self.assertTrue(server.alive())
             print("\n%d scans before the jump, %d after, all mapped in place; tf buffer cleared"
                   % (SCANS, SCANS))
+
+            # The clock stops (a replay over without --keep-alive): a query in a frame tf does
+            # not know is refused after ~tf_timeout (0.2 s) of wall time, not left waiting for
+            # ROS time that no longer moves; one in a known frame is answered.
+            clock.running = False
+            clock.join()
+            started = time.monotonic()
+            response = server.occupancy([(0.0, 0.0, 0.0)], frame_id="nowhere")
+            waited = time.monotonic() - started
+            self.assertFalse(response.success)
+            self.assertIn("cannot transform from 'nowhere'", response.message)
+            self.assertLess(waited, 10.0, "the refusal waited on the stopped clock")
+            response = server.occupancy([(0.0, 0.0, 0.0)], frame_id="base")
+            self.assertTrue(response.success, response.message)
+            print("with the clock stopped: a query in an unknown frame refused after %.2f s"
+                  % waited)
         finally:
             clock.running = False
             clock.join()
