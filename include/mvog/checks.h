@@ -55,7 +55,8 @@ struct BoxCheck {
 /// meet counts as both (eq. 9 at that one height comes from one of the two touching volumes), so
 /// a segment grazing an obstacle's face is occupied.
 ///
-/// Throws ConfigError, naming the field, if `config` or `radius` is invalid, if a segment has a
+/// Throws ConfigError, naming the field, if `config` or `radius` is invalid (a radius must be
+/// finite, >= 0 and at most the map's max_coordinate), if a segment has a
 /// point that is not finite or lies beyond the map's max_coordinate, or if the segments cover more
 /// than config.max_query_cells cells in all (then before any work).
 std::vector<SegmentCheck> checkSegments(const Map& map, const std::vector<Segment>& segments,

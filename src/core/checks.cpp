@@ -320,8 +320,11 @@ void SegmentChecker::clear() { blocks_->clear(); }
 std::vector<SegmentCheck> SegmentChecker::check(const Map& map,
                                                 const std::vector<Segment>& segments,
                                                 double radius) {
-  if (!(std::isfinite(radius) && radius >= 0.0)) {
-    throw ConfigError("radius: must be a finite number >= 0");
+  // At most max_coordinate, as the segments' points: the swept rows' cell indices then stay
+  // within 2 * 4194304 (MapConfig::validate), far from int32's limit, and no request covers more
+  // than that many rows to count.
+  if (!(std::isfinite(radius) && radius >= 0.0 && radius <= map.config().max_coordinate)) {
+    throw ConfigError("radius: must be a finite number >= 0 and at most the map's max_coordinate");
   }
   blocks_->follow(map);
   CheckContext context{map, config_.occupancy_threshold, *blocks_, {}, {}};

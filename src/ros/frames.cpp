@@ -13,17 +13,20 @@ Eigen::Isometry3d latestTransform(const tf2_ros::Buffer& tf_buffer, const std::s
     return TransformUnavailable("cannot transform from '" + frame + "' to '" + map_frame +
                                 "': " + why);
   };
+  // A tf1-style leading '/' is dropped, as on the sensors' frames (tf2 refuses such names).
+  const std::string tf2_frame = !frame.empty() && frame.front() == '/' ? frame.substr(1) : frame;
   // The wait runs on the wall clock, not on tf2's ROS time: replaying a bag with --clock and
   // without --keep-alive, ROS time stops at the bag's end, and a request in a frame tf does not
   // know would wait for ever.
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-  std::string why;
-  while (!tf_buffer.canTransform(map_frame, frame, ros::Time(0), &why)) {
+  for (;;) {
+    std::string why;  // tf2 appends to it: one poll's reason
+    if (tf_buffer.canTransform(map_frame, tf2_frame, ros::Time(0), &why)) break;
     if (ros::WallTime::now() >= deadline || !ros::ok()) throw unavailable(why);
     ros::WallDuration(kTransformPollPeriod).sleep();
   }
   try {
-    return tf2::transformToEigen(tf_buffer.lookupTransform(map_frame, frame, ros::Time(0)));
+    return tf2::transformToEigen(tf_buffer.lookupTransform(map_frame, tf2_frame, ros::Time(0)));
   } catch (const tf2::TransformException& e) {  // gone from the buffer since canTransform
     throw unavailable(e.what());
   }

@@ -176,6 +176,17 @@ TEST(SegmentChecks, BoundsTheWorkAndRefusesBadInput) {
                ConfigError);
   EXPECT_THROW(checkSegments(map, {{{0, 0, 0}, {1, 1, 1}}}, -0.1), ConfigError);
   EXPECT_THROW(checkSegments(map, {{{0, 0, 0}, {1, 1, 1}}}, NAN), ConfigError);
+  // A radius beyond max_coordinate (10 km) is refused, however large: at 2^31 cells, a radius of
+  // 1.08e8 m at 0.1 m once overflowed the swept rows' indices and the check answered free.
+  for (double radius : {1.0e4 + 1.0, 1.08e8, 1.0e300}) {
+    EXPECT_THROW(checkSegments(map, {{{0, 0, 0}, {1, 1, 1}}}, radius), ConfigError) << radius;
+  }
+  try {  // at max_coordinate: its cells are counted, and too many
+    checkSegments(map, {{{0, 0, 0}, {1, 1, 1}}}, 1.0e4);
+    FAIL() << "not refused";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("max_query_cells"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(checkSegments(map, {{{0, NAN, 0}, {1, 1, 1}}}, 0.0), ConfigError);
   EXPECT_THROW(checkSegments(map, {{{0, 0, 0}, {1e5, 1, 1}}}, 0.0), ConfigError);
   PlanningConfig bad;

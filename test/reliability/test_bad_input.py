@@ -354,8 +354,13 @@ class BadInput(unittest.TestCase):
         response = self.server.occupancy([(1.0, 0.0, 0.5)], frame_id="nowhere")
         self.assertFalse(response.success)
         self.assertIn("nowhere", response.message)
+        # One reason, not one per poll of tf while the server waited (~tf_timeout).
+        self.assertLess(len(response.message), 200, response.message)
         record("get_occupancy in an unknown frame", "refused: \"%s\"" %
                response.message.split("\n")[0][:110])
+        response = self.server.occupancy([(1.0, 0.0, 0.5)], frame_id="/map")
+        self.assertTrue(response.success, response.message)
+        record("get_occupancy in frame '/map' (tf1's leading '/')", "answered, as in 'map'")
 
     def test_planning_queries(self):
         """check_segments and check_boxes refuse what they cannot answer, saying why."""
@@ -389,6 +394,8 @@ class BadInput(unittest.TestCase):
              lambda: segments([(good[0], (1e300, 0.0, 0.5))])),
             ("check_segments with a NaN radius", lambda: segments([good], radius=NAN)),
             ("check_segments with a negative radius", lambda: segments([good], radius=-0.1)),
+            ("check_segments with a radius beyond ~max_coordinate",
+             lambda: segments([good], radius=1e12)),
             ("check_segments over more than ~max_query_cells cells",
              lambda: segments([((-9000.0, 0.0, 0.5), (9000.0, 0.0, 0.5))], radius=100.0)),
             ("check_segments in an unknown frame", lambda: segments([good], frame_id="nowhere")),
