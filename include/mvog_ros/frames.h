@@ -14,6 +14,9 @@ class TransformUnavailable : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// `frame` as tf2 names frames: a tf1-style leading '/' dropped (tf2 refuses such names).
+std::string tf2FrameId(const std::string& frame);
+
 /// The latest transform from `frame` into `map_frame`, waiting up to `timeout` s of wall time for
 /// it (ROS time may stand still: a replayed bag over). Throws
 /// TransformUnavailable: "cannot transform from 'FRAME' to 'MAP_FRAME': why".

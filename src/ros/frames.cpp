@@ -7,14 +7,17 @@ namespace mvog_ros {
 /// How often a wait for a transform asks tf again (s of wall time).
 constexpr double kTransformPollPeriod = 0.005;
 
+std::string tf2FrameId(const std::string& frame) {
+  return !frame.empty() && frame.front() == '/' ? frame.substr(1) : frame;
+}
+
 Eigen::Isometry3d latestTransform(const tf2_ros::Buffer& tf_buffer, const std::string& map_frame,
                                   const std::string& frame, double timeout) {
   auto unavailable = [&](const std::string& why) {
     return TransformUnavailable("cannot transform from '" + frame + "' to '" + map_frame +
                                 "': " + why);
   };
-  // A tf1-style leading '/' is dropped, as on the sensors' frames (tf2 refuses such names).
-  const std::string tf2_frame = !frame.empty() && frame.front() == '/' ? frame.substr(1) : frame;
+  const std::string tf2_frame = tf2FrameId(frame);
   // The wait runs on the wall clock, not on tf2's ROS time: replaying a bag with --clock and
   // without --keep-alive, ROS time stops at the bag's end, and a request in a frame tf does not
   // know would wait for ever.

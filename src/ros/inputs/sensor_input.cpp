@@ -4,6 +4,8 @@
 
 #include <tf2_eigen/tf2_eigen.h>
 
+#include "mvog_ros/frames.h"
+
 namespace mvog_ros {
 namespace {
 
@@ -36,9 +38,8 @@ void SensorInput::stop() {
 }
 
 void SensorInput::receive(std_msgs::Header header, ConvertAndEnqueue convert_and_enqueue) {
-  std::string& frame_id = header.frame_id;
-  if (!frame_id.empty() && frame_id.front() == '/') frame_id.erase(0, 1);  // tf1 style
-  if (frame_id.empty()) {
+  header.frame_id = tf2FrameId(header.frame_id);
+  if (header.frame_id.empty()) {
     dropForTransform(header, "its frame_id is empty");
     return;
   }
