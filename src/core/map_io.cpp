@@ -101,11 +101,15 @@ Map deserializeMap(const std::uint8_t* data, std::size_t size) {
   const std::uint64_t cell_count = header.u64();
   const std::uint64_t volume_count = header.u64();
   const std::uint32_t rules = header.u32();
-  if (rules & ~detail::kAllRuleBits) invalidMap("unknown bits in the model's rules");
-  config.rules = detail::rulesOf(rules);
   if (version == 1) {
-    if (header.u64() != 0 || header.u32() != 0) invalidMap("reserved header bytes are not zero");
+    // Version 1's 16 bytes at 48 were reserved (zero): its maps are the paper's model.
+    if (rules != 0 || header.u64() != 0 || header.u32() != 0) {
+      invalidMap("reserved header bytes are not zero");
+    }
+    config.rules = ModelRules::paper();
   } else {
+    if (rules & ~detail::kAllRuleBits) invalidMap("unknown bits in the model's rules");
+    config.rules = detail::rulesOf(rules);
     config.rules.out_of_range_free_length = header.f64();
     if (header.u32() != 0) invalidMap("reserved header bytes are not zero");
   }

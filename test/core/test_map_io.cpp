@@ -545,5 +545,38 @@ TEST(MapIo, RandomCorruptionsNeverCrash) {
   EXPECT_GT(loaded, 0u);  // changed masses and heights can be valid
 }
 
+TEST(MapIo, AMapWhoseFirstCellIsTheOriginRoundTrips) {
+  // Cell (0, 0) first (and alone): counted in the header like any other.
+  Map map(test::unitConfig());
+  map.setCellVolumes({0, 0}, CellVolumes{{{0.0f, 1.0f, 1.0f}}, {{2.5f, 4.0f, 1.5f}}});
+  const Bytes bytes = serializeMap(map);
+  EXPECT_EQ(bytes.size(), 64u + 16u + 2u * 12u + 8u);
+  const Map loaded = deserializeMap(bytes.data(), bytes.size());
+  EXPECT_TRUE(test::sameVolumes(allVolumes(loaded), allVolumes(map)));
+}
+
+TEST(MapIo, RefusesCountsThatLeaveBytesUnread) {
+  // The size must equal 64 + 16 C + 12 V + 8: counts describing the first two cells only
+  // (2 cells, 4 volumes) leave the third cell's bytes over.
+  Bytes bad = buildFile(0.5, 100.0, smallCells());
+  putLe(bad, kCellCountOffset, 2, 8);
+  putLe(bad, kVolumeCountOffset, 4, 8);
+  fixChecksum(bad);
+  EXPECT_TRUE(refused(bad));
+}
+
+TEST(MapIo, RefusesVersionOneFilesWithReservedBytesSet) {
+  // Version 1 had 16 reserved bytes (zero) at 48, where version 2 keeps the rules: a version 1
+  // file with rule bits there is not the paper's model it claims to be.
+  const Bytes file = buildFile(0.5, 100.0, smallCells(), 1, 0);
+  ASSERT_FALSE(refused(file));
+  for (const std::size_t offset : {48u, 52u, 56u, 60u}) {
+    Bytes bad = file;
+    bad[offset] = 1;
+    fixChecksum(bad);
+    EXPECT_TRUE(refused(bad)) << offset;
+  }
+}
+
 }  // namespace
 }  // namespace mvog
