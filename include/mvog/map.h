@@ -273,8 +273,8 @@ class Map {
   /// Makes the box [min_corner, max_corner] (m) unknown: in the cells whose squares meet its
   /// footprint ([floor(s min), ceil(s max)) in x and y), volumes are cut at its bottom and top,
   /// the parts outside keeping their mass in proportion to their height (parts lower than 1
-  /// go too: Sec. III-A); a column wholly inside is removed. A box lower than one cell's height
-  /// (1 / s) is cleared a little over one cell high around its centre: a column cannot hold a
+  /// go too: Sec. III-A); a column wholly inside is removed. A box one cell high (1 / s) or lower
+  /// is cleared a little over one cell high around its centre: a column cannot hold a
   /// gap of 1 or less. Infinite corners are allowed. Returns the number of cells changed.
   /// Throws ConfigError, changing nothing, for a NaN corner or a box empty or inverted on an axis.
   std::size_t clearBox(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& max_corner);

@@ -303,5 +303,54 @@ TEST(BoxChecks, AFlatBoxHasNoKnownFractionAndTheLimitHolds) {
   EXPECT_THROW(checkBoxes(map, {{{0, 0, 0}, {INFINITY, 1, 1}}}), ConfigError);
 }
 
+TEST(SegmentChecks, TheLimitOfCellsIsInclusive) {
+  // A segment along x over cells 0..40 (radius 0) visits 41 cells: at most 41 is allowed.
+  const Map map = test::sceneMap();
+  PlanningConfig config;
+  config.max_query_cells = 41;
+  EXPECT_NO_THROW(checkSegments(map, {{{0.05, 0.5, 1.0}, {4.05, 0.5, 1.0}}}, 0.0, config));
+  config.max_query_cells = 40;
+  EXPECT_THROW(checkSegments(map, {{{0.05, 0.5, 1.0}, {4.05, 0.5, 1.0}}}, 0.0, config),
+               ConfigError);
+  // One cell: one segment within it visits 1 cell, two visit 2.
+  config.max_query_cells = 1;
+  EXPECT_NO_THROW(checkSegments(map, {{{0.05, 0.5, 1.0}, {0.06, 0.5, 1.0}}}, 0.0, config));
+  EXPECT_THROW(
+      checkSegments(map, std::vector<Segment>(2, Segment{{0.05, 0.5, 1.0}, {0.06, 0.5, 1.0}}), 0.0,
+                    config),
+      ConfigError);
+}
+
+TEST(SegmentChecks, ASweptSphereTouchingAnObstaclesFaceExactlyMeetsIt) {
+  // Resolution 1: one obstacle fills cell (3, 1), the square [3, 4) x [1, 2), over heights
+  // [0, 1]. A segment along y = 0.5, z = 0.5 with a radius of 0.5 reaches y = 1 exactly: the
+  // sphere touches the obstacle's face y = 1 (touching a face counts), whose points lie in the
+  // cell: occupied.
+  Map map(test::unitConfig());
+  map.setCellVolumes({3, 1}, CellVolumes{{{0.0f, 1.0f, 1.0f}}, {}});
+  EXPECT_EQ(checkOne(map, {0.5, 0.5, 0.5}, {5.5, 0.5, 0.5}, 0.5).state, OccupancyState::kOccupied);
+  EXPECT_EQ(checkOne(map, {0.5, 0.5, 0.5}, {5.5, 0.5, 0.5}, 0.4).state, OccupancyState::kUnknown);
+}
+
+TEST(BoxChecks, TheStateIsTheWorstOverEveryCell) {
+  // Resolution 1: cell (0, 0) occupied over [0, 2], cell (1, 0) free over [0, 2]. A box over both
+  // is occupied, whichever cell comes last.
+  Map map(test::unitConfig());
+  map.setCellVolumes({{{0, 0}, {{{0.0f, 2.0f, 2.0f}}, {}}}, {{1, 0}, {{}, {{0.0f, 2.0f, 2.0f}}}}});
+  EXPECT_EQ(checkOne(map, {0.5, 0.2, 0.5}, {1.5, 0.8, 1.5}).state, OccupancyState::kOccupied);
+  EXPECT_EQ(checkOne(map, {1.2, 0.2, 0.5}, {1.5, 0.8, 1.5}).state, OccupancyState::kFree);
+}
+
+TEST(BoxChecks, ABoxTouchingAnObstaclesBottomHoldsItsProbability) {
+  // Resolution 1: cell (0, 0) holds only an obstacle [5, 7]. The box's top face z = 5 (corners
+  // included) holds points of it, where p = 1 (occupancy() says so): occupied, highest p 1.
+  Map map(test::unitConfig());
+  map.setCellVolumes({0, 0}, CellVolumes{{{5.0f, 7.0f, 2.0f}}, {}});
+  ASSERT_EQ(*map.occupancy({0.5, 0.5, 5.0}).probability, 1.0f);
+  const BoxCheck check = checkOne(map, {0.2, 0.2, 3.0}, {0.8, 0.8, 5.0});
+  EXPECT_EQ(check.state, OccupancyState::kOccupied);
+  EXPECT_EQ(check.max_probability, 1.0);
+}
+
 }  // namespace
 }  // namespace mvog

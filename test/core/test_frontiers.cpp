@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <random>
 #include <set>
 #include <tuple>
@@ -233,6 +234,91 @@ TEST(Frontiers, RefusesAnInvalidConfig) {
   config.frontier_min_z = 2.0;
   config.frontier_max_z = 1.0;
   EXPECT_THROW(Frontiers{config}, ConfigError);
+}
+
+/// The heights (m) of the frontier voxels of cell (x, y) at resolution 1, from the lowest.
+std::vector<float> frontierHeightsAt(const Frontiers& frontiers, int x, int y) {
+  std::vector<float> heights;
+  for (const FrontierPoint& p : frontiers.points()) {
+    if (p.x == static_cast<float>(x) + 0.5f && p.y == static_cast<float>(y) + 0.5f)
+      heights.push_back(p.z);
+  }
+  return heights;
+}
+
+TEST(Frontiers, TopsAndBottomsOnTheBandsEdgesAndFacesMeetingUnknownAtOneHeight) {
+  // Resolution 1. Cell (5, 5) and its four neighbours are free over [0, 5], unknown above and
+  // below: the centre's free interval meets its neighbours' unknown space only at the heights 0
+  // and 5 (no positive length: no lateral frontier); its top 5 has unknown space above (voxel 4)
+  // and its bottom 0 unknown space below (voxel 0), each a frontier where it lies in the band,
+  // the band's bounds included.
+  // Cell (20, 20) is free over [0, 10.5] under an obstacle [10.5, 12], its four neighbours free
+  // over [0, 10.5] only: their unknown space above meets its free space at 10.5 alone: only its
+  // bottom (voxel 0) is a frontier.
+  Map map(test::unitConfig());
+  std::vector<Map::CellAssignment> cells;
+  for (const CellIndex& c :
+       {CellIndex{5, 5}, CellIndex{4, 5}, CellIndex{6, 5}, CellIndex{5, 4}, CellIndex{5, 6}}) {
+    cells.push_back({c, {{}, {test::freeSpace(0, 5)}}});
+  }
+  cells.push_back({{20, 20}, {{test::obstacle(10.5f, 12)}, {test::freeSpace(0, 10.5f)}}});
+  for (const CellIndex& c :
+       {CellIndex{19, 20}, CellIndex{21, 20}, CellIndex{20, 19}, CellIndex{20, 21}}) {
+    cells.push_back({c, {{}, {test::freeSpace(0, 10.5f)}}});
+  }
+  map.setCellVolumes(cells);
+  const auto heights = [&](double min_z, double max_z, int x, int y) {
+    PlanningConfig config;
+    config.frontier_min_z = min_z;
+    config.frontier_max_z = max_z;
+    config.frontier_min_cells = 1;
+    Frontiers frontiers(config);
+    frontiers.update(map);
+    return frontierHeightsAt(frontiers, x, y);
+  };
+  const double inf = test::kInf;
+  EXPECT_EQ(heights(-inf, inf, 5, 5), (std::vector<float>{0.5f, 4.5f}));
+  EXPECT_EQ(heights(5.0, inf, 5, 5), (std::vector<float>{4.5f}));  // the top on the band's min
+  EXPECT_EQ(heights(-inf, 5.0, 5, 5), (std::vector<float>{0.5f, 4.5f}));  // ... on its max
+  EXPECT_EQ(heights(0.0, inf, 5, 5), (std::vector<float>{0.5f, 4.5f}));   // the bottom on its min
+  EXPECT_EQ(heights(-inf, 0.0, 5, 5), (std::vector<float>{0.5f}));        // ... on its max
+  EXPECT_EQ(heights(-inf, inf, 20, 20), (std::vector<float>{0.5f}));
+}
+
+TEST(Frontiers, PiecesAre26Connected) {
+  // Resolution 1, frontier_min_cells 1.
+  //  - Cell (30, 30), free over [0, 5] with unknown space above and below; its neighbour (31, 30)
+  //    is occupied over [0, 2] and [4, 6], the others over [-1, 6]: its frontier voxels are 0
+  //    (bottom), 2 and 3 (beside the unknown [2, 4]) and 4 (top): 2, 3, 4 are one piece.
+  //  - Cells (40, 40) and (41, 40), free over [4, 5] and [5, 6]: voxels 4 and 5, touching at an
+  //    edge: one piece.
+  //  - Cells (50, 50) and (49, 51), free over [4, 5]: voxels 4 and 4, touching at a vertical edge
+  //    (diagonal neighbours): one piece.
+  Map map(test::unitConfig());
+  std::vector<Map::CellAssignment> cells{
+      {{30, 30}, {{}, {test::freeSpace(0, 5)}}},
+      {{31, 30}, {{test::obstacle(0, 2), test::obstacle(4, 6)}, {}}},
+      {{40, 40}, {{}, {test::freeSpace(4, 5)}}},
+      {{41, 40}, {{}, {test::freeSpace(5, 6)}}},
+      {{50, 50}, {{}, {test::freeSpace(4, 5)}}},
+      {{49, 51}, {{}, {test::freeSpace(4, 5)}}}};
+  for (const CellIndex& c : {CellIndex{29, 30}, CellIndex{30, 29}, CellIndex{30, 31}}) {
+    cells.push_back({c, {{test::obstacle(-1, 6)}, {}}});
+  }
+  map.setCellVolumes(cells);
+  PlanningConfig config;
+  config.frontier_min_cells = 1;
+  Frontiers frontiers(config);
+  frontiers.update(map);
+  std::map<std::tuple<float, float, float>, std::uint32_t> cluster;
+  for (const FrontierPoint& p : frontiers.points()) cluster[{p.x, p.y, p.z}] = p.cluster;
+  ASSERT_EQ(frontierHeightsAt(frontiers, 30, 30), (std::vector<float>{0.5f, 2.5f, 3.5f, 4.5f}));
+  EXPECT_NE(cluster.at({30.5f, 30.5f, 0.5f}), cluster.at({30.5f, 30.5f, 2.5f}));
+  EXPECT_EQ(cluster.at({30.5f, 30.5f, 2.5f}), cluster.at({30.5f, 30.5f, 3.5f}));
+  EXPECT_EQ(cluster.at({30.5f, 30.5f, 3.5f}), cluster.at({30.5f, 30.5f, 4.5f}));
+  EXPECT_EQ(cluster.at({40.5f, 40.5f, 4.5f}), cluster.at({41.5f, 40.5f, 5.5f}));
+  EXPECT_EQ(cluster.at({50.5f, 50.5f, 4.5f}), cluster.at({49.5f, 51.5f, 4.5f}));
+  EXPECT_EQ(frontiers.numClusters(), 4u);
 }
 
 }  // namespace

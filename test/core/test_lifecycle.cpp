@@ -510,5 +510,68 @@ TEST(TileRemovals, TheRecordIsBoundedAndSaysWhenItForgot) {
   EXPECT_EQ(recent->size(), 7u);
 }
 
+TEST(ClearBox, PartsExactlyOneHighStayAndVolumesTouchingTheBoxAreNotChanged) {
+  // Resolution 1. Cell (0, 0): a volume [0, 10], cleared over [1, 5]: the part below, [0, 1], is
+  // exactly 1 high, not lower: it stays, with the mass in proportion (1 of 10).
+  Map map(test::unitConfig(100.0, ModelRules::paper()));
+  map.setCellVolumes({0, 0}, CellVolumes{{{0, 10, 10}}, {}});
+  EXPECT_EQ(map.clearBox({0.0, 0.0, 1.0}, {1.0, 1.0, 5.0}), 1u);
+  const CellVolumes after = map.cellVolumes({0, 0});
+  ASSERT_EQ(after.positive.size(), 2u);
+  EXPECT_TRUE(test::volumeIs(after.positive[0], 0.0, 1.0, 1.0));
+  EXPECT_TRUE(test::volumeIs(after.positive[1], 5.0, 10.0, 5.0));
+  // Cell (5, 0): volumes [0, 2] and [6, 8] only touch a box over [2, 6]: nothing of them lies
+  // within it, no cell changes.
+  map.setCellVolumes({5, 0}, CellVolumes{{{0, 2, 2}, {6, 8, 2}}, {}});
+  const std::uint64_t revision = map.revision();
+  EXPECT_EQ(map.clearBox({5.0, 0.0, 2.0}, {6.0, 1.0, 6.0}), 0u);
+  EXPECT_EQ(map.revision(), revision);
+  EXPECT_EQ(map.cellVolumes({5, 0}).positive.size(), 2u);
+}
+
+TEST(ClearBox, ABoxExactlyOneCellHighLeavesAGapOverOne) {
+  // Cut at a box exactly 1 high, the parts would lie exactly 1 apart, which Sec. III-A forbids
+  // (gaps > 1): the box is widened as a thinner one is.
+  Map map(test::unitConfig(100.0, ModelRules::paper()));
+  map.setCellVolumes({0, 0}, CellVolumes{{{0, 10, 10}}, {}});
+  EXPECT_EQ(map.clearBox({0.0, 0.0, 5.0}, {1.0, 1.0, 6.0}), 1u);
+  const CellVolumes after = map.cellVolumes({0, 0});
+  ASSERT_EQ(after.positive.size(), 2u);
+  EXPECT_GT(after.positive[1].bottom - after.positive[0].top, 1.0f);
+  EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+}
+
+TEST(DropTiles, ATileAtExactlyTheRadiusStays) {
+  // Resolution 1: cell (5, 5) in tile (0, 0), cell (20, 5) in tile (1, 0) (x in [16, 32)). From
+  // (5.5, 5.5), tile (0, 0) lies at 0 and tile (1, 0) at 10.5: neither is wholly farther than a
+  // radius of 10.5, and only tile (1, 0) is wholly farther than a radius of 0.
+  Map map(test::unitConfig());
+  map.setCellVolumes({{{5, 5}, {{{0, 1, 1}}, {}}}, {{20, 5}, {{{0, 1, 1}}, {}}}});
+  EXPECT_TRUE(map.dropTilesFartherThan({5.5, 5.5}, 10.5).empty());
+  const Map dropped = map.dropTilesFartherThan({5.5, 5.5}, 0.0);
+  EXPECT_EQ(tilesOf(map), (std::set<std::pair<int, int>>{{0, 0}}));
+  EXPECT_EQ(tilesOf(dropped), (std::set<std::pair<int, int>>{{1, 0}}));
+  // The dropped map's tiles are changes since a new map's revision (Map::tilesModifiedSince).
+  const std::vector<TileIndex> modified =
+      dropped.tilesModifiedSince(Map(dropped.config()).revision());
+  ASSERT_EQ(modified.size(), 1u);
+  EXPECT_EQ(modified[0], (TileIndex{1, 0}));
+}
+
+TEST(TileRemovals, ARemovalIsNotListedSinceTheRevisionItMade) {
+  // tilesRemovedSince(r) lists the tiles removed after r: not one removed by the change that
+  // made r (as tilesModifiedSince(r) does not list the tiles that change modified).
+  Map map(test::unitConfig());
+  map.setCellVolumes({{{0, 0}, {{{0, 1, 1}}, {}}}, {{16, 0}, {{{0, 1, 1}}, {}}}});
+  const std::uint64_t before = map.revision();
+  EXPECT_EQ(map.clearBox({16.0, 0.0, -10.0}, {17.0, 1.0, 10.0}), 1u);
+  const std::optional<std::vector<TileIndex>> since_before = map.tilesRemovedSince(before);
+  ASSERT_TRUE(since_before.has_value());
+  EXPECT_EQ(since_before->size(), 1u);
+  const std::optional<std::vector<TileIndex>> since_now = map.tilesRemovedSince(map.revision());
+  ASSERT_TRUE(since_now.has_value());
+  EXPECT_TRUE(since_now->empty());
+}
+
 }  // namespace
 }  // namespace mvog

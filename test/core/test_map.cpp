@@ -640,5 +640,29 @@ TEST(ChangeTracking, ListsExactlyTheTilesWhoseCellsChanged) {
   }
 }
 
+TEST(Config, EachMapConfigFieldIsCheckedOnItsOwn) {
+  // Resolution 0 with a valid max_coordinate: the error names resolution, not max_coordinate.
+  try {
+    MapConfig{0.0, 100.0, {}}.validate();
+    ADD_FAILURE() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).find("max_coordinate"), std::string::npos) << e.what();
+  }
+  // At most 4194304 cells: the bound itself is allowed.
+  const MapConfig at_the_bound{1.0, 4194304.0, {}};
+  EXPECT_NO_THROW(at_the_bound.validate());
+  const MapConfig beyond_the_bound{1.0, 4194305.0, {}};
+  expectConfigError([&] { beyond_the_bound.validate(); }, "max_coordinate");
+  // out_of_range_free_length must be > 0 (infinity for no limit).
+  for (const double length : {0.0, -1.0, kNaN}) {
+    MapConfig config;
+    config.rules.out_of_range_free_length = length;
+    expectConfigError([&] { config.validate(); }, "out_of_range_free_length");
+  }
+  MapConfig unlimited;
+  unlimited.rules.out_of_range_free_length = kInf;
+  EXPECT_NO_THROW(unlimited.validate());
+}
+
 }  // namespace
 }  // namespace mvog

@@ -452,5 +452,53 @@ TEST(MergeIntoMapFile, CreatesMergesAndRefusesWithoutTouchingTheFile) {
   ::rmdir(directory);
 }
 
+TEST(GridTransform, RefusesMirrorsShearsAndScalesThatMapTheGridOntoItself) {
+  // None of these is rigid (GridTransform::fromMatrix: "not rigid"), though each takes whole
+  // cells to whole cells: each must be refused.
+  Eigen::Matrix4d swap_xy = Eigen::Matrix4d::Identity();  // a mirror: x <-> y
+  swap_xy(0, 0) = swap_xy(1, 1) = 0.0;
+  swap_xy(0, 1) = swap_xy(1, 0) = 1.0;
+  EXPECT_THROW(GridTransform::fromMatrix(swap_xy, 0.05), ConfigError);
+  Eigen::Matrix4d shear = Eigen::Matrix4d::Identity();  // x += y
+  shear(0, 1) = 1.0;
+  EXPECT_THROW(GridTransform::fromMatrix(shear, 0.05), ConfigError);
+  Eigen::Matrix4d flip_z = Eigen::Matrix4d::Identity();  // a mirror: z -> -z
+  flip_z(2, 2) = -1.0;
+  EXPECT_THROW(GridTransform::fromMatrix(flip_z, 0.05), ConfigError);
+  Eigen::Matrix4d stretch_z = Eigen::Matrix4d::Identity();  // z -> 2 z
+  stretch_z(2, 2) = 2.0;
+  EXPECT_THROW(GridTransform::fromMatrix(stretch_z, 0.05), ConfigError);
+}
+
+TEST(Merge, ClosesGapsOfAtMostOneAtDensityOneInBothLists) {
+  // Eq. (8): volumes of one list 1 or less apart merge, the gap added at density 1 (8a), the
+  // masses summed (8b): in the positive list as in the negative one.
+  Map map(test::unitConfig());  // the paper's rules: no split, no clipping
+  Map other(test::unitConfig());
+  map.setCellVolumes({3, 4}, CellVolumes{{{0.0f, 1.0f, 1.0f}}, {{10.0f, 12.0f, 2.0f}}});
+  other.setCellVolumes({3, 4}, CellVolumes{{{1.5f, 2.5f, 1.0f}}, {{12.5f, 14.0f, 3.0f}}});
+  map.merge(other);
+  const CellVolumes merged = map.cellVolumes({3, 4});
+  ASSERT_EQ(merged.positive.size(), 1u);
+  EXPECT_TRUE(test::volumeIs(merged.positive[0], 0.0, 2.5, 1.0 + 0.5 + 1.0));
+  ASSERT_EQ(merged.negative.size(), 1u);
+  EXPECT_TRUE(test::volumeIs(merged.negative[0], 10.0, 14.0, 2.0 + 0.5 + 3.0));
+}
+
+TEST(Merge, RefusesACellLandingBeyondMaxCoordinateEvenPastTheInt32Range) {
+  // A shift of 2^32 cells takes cell (0, 0) far beyond max_coordinate (GridTransform::target is
+  // 64-bit): refused, changing nothing, not wrapped onto a cell of the map.
+  Map map(test::unitConfig(100.0));
+  map.setCellVolumes({0, 0}, CellVolumes{{{5.0f, 6.0f, 1.0f}}, {}});
+  Map other(test::unitConfig(100.0));
+  other.setCellVolumes({0, 0}, CellVolumes{{{0.0f, 1.0f, 1.0f}}, {}});
+  const Bytes bytes = serializeMap(map);
+  for (const std::int64_t shift : {std::int64_t{1} << 32, -(std::int64_t{1} << 32)}) {
+    EXPECT_THROW(map.merge(other, GridTransform{0, shift, 0, 0.0}), ConfigError) << shift;
+    EXPECT_THROW(map.merge(other, GridTransform{0, 0, shift, 0.0}), ConfigError) << shift;
+  }
+  EXPECT_EQ(serializeMap(map), bytes);
+}
+
 }  // namespace
 }  // namespace mvog

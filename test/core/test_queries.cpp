@@ -441,5 +441,33 @@ TEST(Column, ViewsTheListsCellVolumesCopies) {
   EXPECT_TRUE(map.column({100000, 0}).empty());
 }
 
+TEST(Projection, Equation9WhereFreePiecesCoverAnObstacleExactly) {
+  // Split free space (ModelRules::split_free_space_at_obstacles), resolution 1. Cell (0, 0): an
+  // obstacle [3, 7] (rho+ = 1) under free pieces [0, 3] (rho- = 0.01) and [3, 7] (rho- = 10);
+  // at height 3 eq. (9) takes the lower piece: p = 1 / 1.01, occupied (occupancy() says so).
+  // Cell (1, 0): the same obstacle with only the piece [3, 7] (rho- = 10): p = 1 / 11 over all
+  // of it, free.
+  Map map(unitConfig(10000.0, ModelRules{}));
+  map.setCellVolumes({{{0, 0}, {{{3.0f, 7.0f, 4.0f}}, {{0.0f, 3.0f, 0.03f}, {3.0f, 7.0f, 40.0f}}}},
+                      {{1, 0}, {{{3.0f, 7.0f, 4.0f}}, {{3.0f, 7.0f, 40.0f}}}}});
+  ASSERT_EQ(map.occupancy({0.5, 0.5, 3.0}).state(0.5), OccupancyState::kOccupied);
+  ASSERT_EQ(map.occupancy({1.5, 0.5, 3.0}).state(0.5), OccupancyState::kFree);
+  ASSERT_EQ(map.occupancy({1.5, 0.5, 7.0}).state(0.5), OccupancyState::kFree);
+  const Projection projection = map.projection(0.0, 10.0, 0.5, {{0, 0}, {1, 0}});
+  EXPECT_EQ(projection.at(0, 0), OccupancyState::kOccupied);
+  EXPECT_EQ(projection.at(1, 0), OccupancyState::kFree);
+}
+
+TEST(Occupancy, PointsBeyondMaxCoordinateAreUnknownEvenInACellWithVolumes) {
+  // max_coordinate 10 at resolution 1: cell (10, 0) spans x in [10, 11) and may hold volumes
+  // (setCellVolumes allows |i| <= 11), but only its points with x <= 10 are within bounds.
+  Map map(unitConfig(10.0));
+  map.setCellVolumes({10, 0}, CellVolumes{{{0.0f, 2.0f, 2.0f}}, {}});
+  EXPECT_TRUE(map.occupancy({10.0, 0.5, 1.0}).known());
+  const PointOccupancy beyond = map.occupancy({10.5, 0.5, 1.0});
+  EXPECT_FALSE(beyond.known());
+  EXPECT_EQ(beyond.positive_density, 0.0);
+}
+
 }  // namespace
 }  // namespace mvog

@@ -202,5 +202,36 @@ TEST(TraversableMap, RefusesBadArguments) {
   EXPECT_THROW(Surfaces{config}, ConfigError);
 }
 
+TEST(TraversableMap, TheBoundsOfBandClearanceAndStepAreIncluded) {
+  // Resolution 1; band [0, 2], robot_height 2, max_step 1. Each group of cells lies apart.
+  //  (0, 0):  a floor whose top 0 lies on the band's min, free above: traversable.
+  //  (10, 0): a top at 0.5 with exactly robot_height = 2 free above it, then a ceiling:
+  //           traversable (a clearance of at least robot_height).
+  //  (20, 0), (21, 0): tops at 0.5 and 1.5, a step of exactly max_step: both traversable.
+  //  (30, 0), (30, 1): tops at 0.5 and 2.0 (on the band's max), a step of 1.5: both blocked,
+  //           each by its neighbour along y.
+  Map map(test::unitConfig());
+  map.setCellVolumes(
+      {{{0, 0}, {{test::obstacle(-1, 0)}, {test::freeSpace(0, 5)}}},
+       {{10, 0},
+        {{test::obstacle(-1, 0.5f), test::obstacle(2.5f, 4)}, {test::freeSpace(0.5f, 2.5f)}}},
+       {{20, 0}, {{test::obstacle(-1, 0.5f)}, {test::freeSpace(0.5f, 5)}}},
+       {{21, 0}, {{test::obstacle(-1, 1.5f)}, {test::freeSpace(1.5f, 5)}}},
+       {{30, 0}, {{test::obstacle(-1, 0.5f)}, {test::freeSpace(0.5f, 5)}}},
+       {{30, 1}, {{test::obstacle(-1, 2)}, {test::freeSpace(2, 5)}}}});
+  PlanningConfig config;
+  config.traversable_min_z = 0.0;
+  config.traversable_max_z = 2.0;
+  config.robot_height = 2.0;
+  config.max_step = 1.0;
+  const TraversableMap grid = traversableMap(map, {{-1, -1}, {32, 2}}, config);
+  EXPECT_EQ(traversabilityAt(grid, 0.5, 0.5), Traversability::kTraversable);
+  EXPECT_EQ(traversabilityAt(grid, 10.5, 0.5), Traversability::kTraversable);
+  EXPECT_EQ(traversabilityAt(grid, 20.5, 0.5), Traversability::kTraversable);
+  EXPECT_EQ(traversabilityAt(grid, 21.5, 0.5), Traversability::kTraversable);
+  EXPECT_EQ(traversabilityAt(grid, 30.5, 0.5), Traversability::kBlocked);
+  EXPECT_EQ(traversabilityAt(grid, 30.5, 1.5), Traversability::kBlocked);
+}
+
 }  // namespace
 }  // namespace mvog

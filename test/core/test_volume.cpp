@@ -673,5 +673,17 @@ TEST(CheckColumn, NegativeVolumesTouchOnlyAtObstacleBoundariesAndOnlyWhenSplit) 
   EXPECT_NE(checkColumn(touching.data(), 2, nullptr, 0, true), "");
 }
 
+TEST(ListMerger, APieceBesideAnObstacleExactlyOneHighStaysApart) {
+  // Free space [0, 4] through an obstacle [1, 3]: the parts outside it, [0, 1] and [3, 4], are
+  // exactly kMinVolumeHeight high, not lower: each stays a piece of its own (constraints.h: only
+  // a piece lower than kMinVolumeHeight joins the obstacle's piece), each with the mass within
+  // its heights.
+  const std::vector<Volume> pieces = mergedFree({}, {fresh(0.0f, 4.0f)}, {fresh(1.0f, 3.0f)}, true);
+  ASSERT_EQ(pieces.size(), 3u);
+  EXPECT_TRUE(volumeIs(pieces[0], 0.0, 1.0, 1.0));
+  EXPECT_TRUE(volumeIs(pieces[1], 1.0, 3.0, 2.0));
+  EXPECT_TRUE(volumeIs(pieces[2], 3.0, 4.0, 1.0));
+}
+
 }  // namespace
 }  // namespace mvog
