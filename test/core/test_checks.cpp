@@ -332,6 +332,41 @@ TEST(SegmentChecks, ASweptSphereTouchingAnObstaclesFaceExactlyMeetsIt) {
   EXPECT_EQ(checkOne(map, {0.5, 0.5, 0.5}, {5.5, 0.5, 0.5}, 0.4).state, OccupancyState::kUnknown);
 }
 
+TEST(SegmentChecks, ASweptSphereRunningAlongAnObstaclesFaceAtTheRadiusMeetsIt) {
+  // Resolution 1: one obstacle fills cell (3, 1) over heights [0, 1]. A segment along y = 0.5,
+  // z = 0.5, wholly over x in [3, 4], keeps the distance 0.5 from the face y = 1: with a radius
+  // of 0.5 the sphere touches it all along (touching a face counts), from the start.
+  Map map(test::unitConfig());
+  map.setCellVolumes({3, 1}, CellVolumes{{{0.0f, 1.0f, 1.0f}}, {}});
+  const SegmentCheck check = checkOne(map, {3.2, 0.5, 0.5}, {3.8, 0.5, 0.5}, 0.5);
+  EXPECT_EQ(check.state, OccupancyState::kOccupied);
+  EXPECT_EQ(check.blocked_at, 0.0);
+}
+
+TEST(SegmentChecks, APointWhosePEqualsTheThresholdIsFree) {
+  // Resolution 1: in cell (0, 0) a positive and a negative volume over [0, 1], each of mass 1:
+  // p = 0.5 (eq. 9), free for a threshold of 0.5 (occupied only where p > threshold).
+  Map map(test::unitConfig());
+  map.setCellVolumes({0, 0}, CellVolumes{{{0.0f, 1.0f, 1.0f}}, {{0.0f, 1.0f, 1.0f}}});
+  ASSERT_EQ(*map.occupancy({0.5, 0.5, 0.5}).probability, 0.5f);
+  PlanningConfig config;
+  config.occupancy_threshold = 0.5;
+  EXPECT_EQ(checkSegments(map, {{{0.2, 0.5, 0.5}, {0.8, 0.5, 0.5}}}, 0.0, config).at(0).state,
+            OccupancyState::kFree);
+  const BoxCheck box = checkBoxes(map, {{{0.2, 0.2, 0.2}, {0.8, 0.8, 0.8}}}, config).at(0);
+  EXPECT_EQ(box.state, OccupancyState::kFree);
+  EXPECT_EQ(box.max_probability, 0.5);
+}
+
+TEST(SegmentChecks, FreeSpaceOfMassZeroIsUnknown) {
+  // Resolution 1: cell (0, 0) holds only a negative volume [0, 1] of mass 0 (decayed away):
+  // rho+ + rho- = 0 there, unknown (eq. 9), as occupancy() says.
+  Map map(test::unitConfig());
+  map.setCellVolumes({0, 0}, CellVolumes{{}, {{0.0f, 1.0f, 0.0f}}});
+  ASSERT_FALSE(map.occupancy({0.5, 0.5, 0.5}).known());
+  EXPECT_EQ(checkOne(map, {0.2, 0.5, 0.5}, {0.8, 0.5, 0.5}, 0.0).state, OccupancyState::kUnknown);
+}
+
 TEST(BoxChecks, TheStateIsTheWorstOverEveryCell) {
   // Resolution 1: cell (0, 0) occupied over [0, 2], cell (1, 0) free over [0, 2]. A box over both
   // is occupied, whichever cell comes last.

@@ -62,6 +62,23 @@ TEST(TileChanges, AfterAResetOrAnOlderMapEverythingChanged) {
   EXPECT_EQ(tilesOf(changes.update(other)), (Tiles{{-1, 0}}));
 }
 
+TEST(TileChanges, ATileWhoseFirstCellIsEmptiedIsListedOnceAndThenOnlyWhenItChanges) {
+  Map map(test::unitConfig());
+  map.setCellVolumes({{{1, 1}, {{{0, 1, 1}}, {}}}, {{5, 9}, {{{0, 1, 1}}, {}}}});
+  TileChanges changes;
+  EXPECT_EQ(tilesOf(changes.update(map)), (Tiles{{0, 0}}));
+  // Tile (0, 0) loses a cell but keeps another: it changed, and is still there.
+  map.setCellVolumes({1, 1}, CellVolumes{});
+  EXPECT_EQ(tilesOf(changes.update(map)), (Tiles{{0, 0}}));
+  // Then only tile (1, 0) changes: tile (0, 0) did not.
+  map.setCellVolumes({20, 1}, CellVolumes{{{0, 1, 1}}, {}});
+  EXPECT_EQ(tilesOf(changes.update(map)), (Tiles{{1, 0}}));
+  EXPECT_TRUE(changes.update(map).empty());
+  // Emptying its last cell removes tile (0, 0).
+  map.setCellVolumes({5, 9}, CellVolumes{});
+  EXPECT_EQ(tilesOf(changes.update(map)), (Tiles{{0, 0}}));
+}
+
 TEST(TileChanges, NeighbourTiles) {
   EXPECT_EQ(tilesOf(withNeighbourTiles({{0, 0}, {1, 0}})),
             (Tiles{{0, -1}, {1, -1}, {-1, 0}, {0, 0}, {1, 0}, {2, 0}, {0, 1}, {1, 1}}));

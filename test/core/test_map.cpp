@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "mvog/map.h"
+#include "mvog/planning_config.h"
 #include "test_util.h"
 
 namespace mvog {
@@ -336,6 +337,22 @@ TEST(Map, SetCellVolumesOnADecayedMapKeepsTheGivenMasses) {
   EXPECT_FLOAT_EQ(map.cellVolumes({1, 2}).positive.at(0).mass, 4.0f);
 }
 
+TEST(Map, SetCellVolumesAfterDecayKeepsTheDecayedMassesOfTheTilesOtherCells) {
+  // Decay multiplies every mass by k_d; setting one cell replaces that cell's lists only, so the
+  // other cells of its tile keep their decayed masses.
+  Map map(unitConfig());
+  map.setCellVolumes({1, 2}, CellVolumes{{{0, 2, 4}}, {{-4, -1, 2}}});
+  map.decay(0.5);
+  map.setCellVolumes({3, 2}, CellVolumes{{{0, 1, 1}}, {}});
+  ASSERT_EQ(Map::tileOf({1, 2}), Map::tileOf({3, 2}));
+  EXPECT_EQ(allVolumes(map),
+            (std::vector<test::VolumeRecord>{
+                {1, 2, 0, 0.f, 2.f, 2.f}, {1, 2, 1, -4.f, -1.f, 1.f}, {3, 2, 0, 0.f, 1.f, 1.f}}));
+  map.decay(0.5);
+  EXPECT_FLOAT_EQ(map.cellVolumes({1, 2}).positive.at(0).mass, 1.0f);
+  EXPECT_FLOAT_EQ(map.cellVolumes({3, 2}).positive.at(0).mass, 0.5f);
+}
+
 TEST(Map, SetCellVolumesStoresFreeSpaceAcrossAnObstacleAsTheMergeCutsIt) {
   // Sec. III-A allows one negative volume across a positive one; under
   // split_free_space_at_obstacles it is stored cut at the obstacle's bottom and top, each piece
@@ -380,6 +397,20 @@ TEST(Map, SetCellVolumesReplacesAndEmptiesCells) {
   map.setCellVolumes({5, 5}, CellVolumes{});
   EXPECT_TRUE(map.empty());
   EXPECT_EQ(map.memoryUsage().table_one_bytes, 0u);
+}
+
+TEST(Map, SetCellVolumesRefusesACellGivenTwiceChangingNothing) {
+  // Every cell must appear once in a call; a refused call changes nothing.
+  Map map(unitConfig());
+  map.setCellVolumes({2, 3}, CellVolumes{{{0, 1, 1}}, {}});
+  const std::uint64_t revision = map.revision();
+  const std::vector<test::VolumeRecord> before = allVolumes(map);
+  const CellVolumes volumes{{{0, 2, 3}}, {}};
+  EXPECT_THROW(map.setCellVolumes({{{5, 5}, volumes}, {{2, 3}, volumes}, {{2, 3}, volumes}}),
+               ConfigError);
+  EXPECT_THROW(map.setCellVolumes({{{7, 1}, volumes}, {{7, 1}, CellVolumes{}}}), ConfigError);
+  EXPECT_EQ(allVolumes(map), before);
+  EXPECT_EQ(map.revision(), revision);
 }
 
 // ---- memoryUsage() (Table I)
@@ -458,6 +489,44 @@ TEST(Config, MapConfigFieldsAreChecked) {
     expectConfigError([&] { Map map(config); }, field);
   }
   EXPECT_NO_THROW({ Map map(MapConfig{0.001, 4194.0, ModelRules{}}); });
+}
+
+TEST(Config, PlanningConfigFieldsAreCheckedAtTheEdgesOfTheirRanges) {
+  const auto with = [](auto change) {
+    PlanningConfig config;
+    change(config);
+    return config;
+  };
+  // The edges of each range: a threshold of 0 (any positive p is occupied), one cell a call,
+  // bands of one height, pieces of one voxel, a robot that climbs no step.
+  for (const PlanningConfig& good :
+       {with([](PlanningConfig& c) { c.occupancy_threshold = 0.0; }),
+        with([](PlanningConfig& c) { c.max_query_cells = 1; }),
+        with([](PlanningConfig& c) { c.frontier_min_z = c.frontier_max_z = 1.5; }),
+        with([](PlanningConfig& c) { c.frontier_min_cells = 1; }),
+        with([](PlanningConfig& c) { c.max_step = 0.0; }),
+        with([](PlanningConfig& c) { c.traversable_min_z = c.traversable_max_z = 0.0; })}) {
+    EXPECT_NO_THROW(good.validate());
+  }
+  const std::vector<std::pair<PlanningConfig, std::string>> bad{
+      {with([](PlanningConfig& c) { c.occupancy_threshold = 1.0; }), "occupancy_threshold"},
+      {with([](PlanningConfig& c) { c.occupancy_threshold = -0.1; }), "occupancy_threshold"},
+      {with([](PlanningConfig& c) { c.max_query_cells = 0; }), "max_query_cells"},
+      {with([](PlanningConfig& c) {
+         c.frontier_min_z = 2.0;
+         c.frontier_max_z = 1.0;
+       }),
+       "frontier_min_z"},
+      {with([](PlanningConfig& c) { c.frontier_min_cells = 0; }), "frontier_min_cells"},
+      {with([](PlanningConfig& c) { c.robot_height = 0.0; }), "robot_height"},
+      {with([](PlanningConfig& c) { c.robot_height = kInf; }), "robot_height"},
+      {with([](PlanningConfig& c) { c.max_step = -0.1; }), "max_step"},
+      {with([](PlanningConfig& c) { c.max_step = kInf; }), "max_step"},
+      {with([](PlanningConfig& c) { c.traversable_min_z = kNaN; }), "traversable_min_z"}};
+  for (const auto& [config, field] : bad) {
+    SCOPED_TRACE(field);
+    expectConfigError([&] { config.validate(); }, field);
+  }
 }
 
 TEST(Config, OnlyFinitePointsWithinMaxCoordinateOnEveryAxisAreWithinBounds) {
@@ -638,6 +707,18 @@ TEST(ChangeTracking, ListsExactlyTheTilesWhoseCellsChanged) {
     EXPECT_EQ(modifiedSince(map, revision), changedTiles(before, allVolumes(map)))
         << "insertion " << k;
   }
+}
+
+TEST(ChangeTracking, EmptyingCellsThatHoldNothingChangesNoTile) {
+  // Only the tiles whose volumes changed are listed: emptying cells that hold nothing, in a tile
+  // that exists and in one that does not, changes no tile.
+  Map map(unitConfig());
+  map.setCellVolumes({3, 4}, CellVolumes{{{0, 1, 2}}, {{-4, -1, 3}}});
+  const std::uint64_t revision = map.revision();
+  const std::vector<test::VolumeRecord> before = allVolumes(map);
+  map.setCellVolumes({{{5, 4}, CellVolumes{}}, {{100, 100}, CellVolumes{}}});
+  EXPECT_TRUE(modifiedSince(map, revision).empty());
+  EXPECT_EQ(allVolumes(map), before);
 }
 
 TEST(Config, EachMapConfigFieldIsCheckedOnItsOwn) {

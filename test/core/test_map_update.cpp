@@ -2,6 +2,7 @@
 // after each update, a missed update is detected, and corrupt or foreign bytes are refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -398,6 +399,61 @@ TEST(MapUpdate, AFreeListAcrossAnObstacleIsStoredAsTheMergeCutsIt) {
   EXPECT_EQ(serializeMap(deserializeMap(file.data(), file.size())), file);
 }
 
+TEST(MapUpdate, AFullUpdateOfTheMirrorsOwnRevisionIsApplied) {
+  // Outdated means ending before the mirror's revision of the same source: a full update ending
+  // at it is applied.
+  Small small;
+  MapMirror mirror;
+  const Bytes full = updateOf(small.source, 0);
+  ASSERT_EQ(applyTo(mirror, full).status, MapUpdateStatus::kApplied);
+  EXPECT_EQ(applyTo(mirror, full).status, MapUpdateStatus::kApplied);
+  EXPECT_TRUE(mirrors(mirror, small.source));
+}
+
+TEST(MapUpdate, AFullUpdateWithAMassUnitOrUnitExponentOutOfRangeIsRefused) {
+  // The header's mass unit lies in (0.5, 1] and its unit exponent in [-2^24, 0], whether the
+  // update holds tiles or not.
+  Small small;
+  std::uint64_t bits_half;
+  const double half = 0.5;
+  std::memcpy(&bits_half, &half, 8);
+  const Map empty(small.source.config());
+  for (const Map* source : std::vector<const Map*>{&small.source, &empty}) {
+    const Bytes full = updateOf(*source, 0);
+    auto patched = [&](std::size_t offset, std::uint64_t value) {
+      Bytes bytes = full;
+      putLe(bytes, offset, value, 8);
+      fixChecksum(bytes);
+      return bytes;
+    };
+    for (const Bytes& bytes : {patched(72, bits_half), patched(80, 1)}) {
+      MapMirror mirror;
+      EXPECT_THROW(applyTo(mirror, bytes), MapFileError);
+      EXPECT_EQ(mirror.sourceRevision(), 0u);
+    }
+  }
+}
+
+TEST(MapUpdate, RefusesChangedTilesOutOfOrder) {
+  // The changed tiles come in the order of the map file's, rows from the lowest: two tiles of one
+  // cell and one volume each (records of 16 + 16 + 12 bytes after the 128-byte header of a full
+  // update), swapped, are refused, though each record is valid on its own.
+  Map source(test::unitConfig());
+  source.setCellVolumes({{{3, 4}, {{{0, 1, 2}}, {}}}, {{20, 4}, {{{0, 1, 2}}, {}}}});
+  const Bytes full = updateOf(source, 0);
+  constexpr std::size_t kHeader = 128, kTileRecord = 16 + 16 + 12;
+  ASSERT_EQ(full.size(), kHeader + 2 * kTileRecord + 8);
+  MapMirror accepted;
+  ASSERT_EQ(applyTo(accepted, full).status, MapUpdateStatus::kApplied);
+  Bytes swapped = full;
+  std::rotate(swapped.begin() + kHeader, swapped.begin() + kHeader + kTileRecord,
+              swapped.begin() + kHeader + 2 * kTileRecord);
+  fixChecksum(swapped);
+  MapMirror mirror;
+  EXPECT_THROW(applyTo(mirror, swapped), MapFileError);
+  EXPECT_EQ(mirror.sourceRevision(), 0u);
+}
+
 TEST(MapUpdate, RefusesCorruptOrForeignBytesChangingNothing) {
   Small small;
   Synced synced(small);
@@ -471,11 +527,18 @@ TEST(MapUpdate, RefusesCorruptOrForeignBytesChangingNothing) {
       {"a tile of 3 cells", patched(tile + 12, 3, 4)},
       {"a cell outside its tile", patched(first_cell, 20, 4)},
       {"cells out of order", patched(first_cell, 6, 4)},
+      {"a cell listed twice", patched(first_cell, 5, 4)},
       {"a cell's count changed", patched(first_cell + 8, 0, 4)},
       {"a volume lower than 1", patched(first_volume + 4, 0x3f000000, 4)},
       {"a negative mass", patched(first_volume + 8, 0xbf800000, 4)},
   };
   for (const auto& c : cases) EXPECT_TRUE(refused(c.bytes)) << c.what;
+  // The removed tile listed twice, the counts and the checksum fixed.
+  Bytes removed_twice = update;
+  removed_twice.insert(removed_twice.begin() + tile, update.begin() + 128, update.begin() + tile);
+  putLe(removed_twice, 88, 2, 8);
+  fixChecksum(removed_twice);
+  EXPECT_TRUE(refused(removed_twice)) << "a tile listed removed twice";
   // After a decay step, an incremental update with the unit of before would raise the mirror's.
   const std::uint64_t before_decay = small.source.revision();
   small.source.decay(0.5);

@@ -60,6 +60,20 @@ TEST(Surfaces, ADeskGivesTwoSurfacesAndTheFloorUnderItItsClearance) {
   EXPECT_EQ(surfaces.surfaces().size(), 1099u * 2u + 100u * 3u + 95u + 8u * 2u);
 }
 
+TEST(Surfaces, ATopsProbabilityIsTheOneJustBelowIt) {
+  // Resolution 1, cell (0, 0): an obstacle [0, 2] of density 1 and free space [1, 2] of density
+  // 1: p = 1 over [0, 1) and 0.5 over (1, 2], both occupied (threshold 0.324). One top at z = 2,
+  // its probability eq. (9) just below it: 0.5.
+  Map map(test::unitConfig());
+  map.setCellVolumes({0, 0}, CellVolumes{{{0.0f, 2.0f, 2.0f}}, {{1.0f, 2.0f, 1.0f}}});
+  ASSERT_EQ(*map.occupancy({0.5, 0.5, 1.9}).probability, 0.5f);
+  Surfaces surfaces;
+  surfaces.update(map);
+  ASSERT_EQ(surfaces.surfaces().size(), 1u);
+  EXPECT_EQ(surfaces.surfaces()[0].z, 2.0f);
+  EXPECT_EQ(surfaces.surfaces()[0].probability, 0.5f);
+}
+
 TEST(Surfaces, ClearanceEndsAtUnknownSpaceUncapped) {
   Map map(test::unitConfig(10000.0, ModelRules{}));
   // Floor [0, 1], free up to 4, unknown above; a gap of 2 between free spaces counts as unknown.
