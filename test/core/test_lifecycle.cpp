@@ -422,15 +422,40 @@ TEST(ClearBox, CutsSplitPiecesAtTheBoxAndKeepsMassesInProportion) {
 }
 
 TEST(ClearBox, AThinBoxClearsALittleMoreThanACellHigh) {
+  // A box 0.1 high, and one exactly 1 high: cut there, the parts would lie 1 or less apart, which
+  // Sec. III-A forbids (gaps > 1): each is widened around its centre.
+  for (const double top : {5.1, 6.0}) {
+    SCOPED_TRACE(top);
+    Map map(test::unitConfig(100.0, ModelRules::paper()));
+    map.setCellVolumes({0, 0}, CellVolumes{{{0, 10, 10}}, {}});
+    EXPECT_EQ(map.clearBox({0.0, 0.0, 5.0}, {1.0, 1.0, top}), 1u);
+    const CellVolumes after = map.cellVolumes({0, 0});
+    ASSERT_EQ(after.positive.size(), 2u);
+    EXPECT_GT(after.positive[1].bottom - after.positive[0].top, 1.0f);  // a gap over 1
+    EXPECT_LT(after.positive[1].bottom - after.positive[0].top, 1.0001f);
+    EXPECT_FLOAT_EQ(0.5f * (after.positive[0].top + after.positive[1].bottom),
+                    static_cast<float>(0.5 * (5.0 + top)));
+    EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+  }
+}
+
+TEST(ClearBox, PartsExactlyOneHighStayAndVolumesTouchingTheBoxAreNotChanged) {
+  // Resolution 1. Cell (0, 0): a volume [0, 10], cleared over [1, 5]: the part below, [0, 1], is
+  // exactly 1 high, not lower: it stays, with the mass in proportion (1 of 10).
   Map map(test::unitConfig(100.0, ModelRules::paper()));
   map.setCellVolumes({0, 0}, CellVolumes{{{0, 10, 10}}, {}});
-  EXPECT_EQ(map.clearBox({0.0, 0.0, 5.0}, {1.0, 1.0, 5.1}), 1u);
+  EXPECT_EQ(map.clearBox({0.0, 0.0, 1.0}, {1.0, 1.0, 5.0}), 1u);
   const CellVolumes after = map.cellVolumes({0, 0});
   ASSERT_EQ(after.positive.size(), 2u);
-  EXPECT_GT(after.positive[1].bottom - after.positive[0].top, 1.0f);  // a gap over 1 (Sec. III-A)
-  EXPECT_LT(after.positive[1].bottom - after.positive[0].top, 1.0001f);
-  EXPECT_FLOAT_EQ(0.5f * (after.positive[0].top + after.positive[1].bottom), 5.05f);
-  EXPECT_TRUE(test::mapSatisfiesConstraints(map));
+  EXPECT_TRUE(test::volumeIs(after.positive[0], 0.0, 1.0, 1.0));
+  EXPECT_TRUE(test::volumeIs(after.positive[1], 5.0, 10.0, 5.0));
+  // Cell (5, 0): volumes [0, 2] and [6, 8] only touch a box over [2, 6]: nothing of them lies
+  // within it, no cell changes.
+  map.setCellVolumes({5, 0}, CellVolumes{{{0, 2, 2}, {6, 8, 2}}, {}});
+  const std::uint64_t revision = map.revision();
+  EXPECT_EQ(map.clearBox({5.0, 0.0, 2.0}, {6.0, 1.0, 6.0}), 0u);
+  EXPECT_EQ(map.revision(), revision);
+  EXPECT_EQ(map.cellVolumes({5, 0}).positive.size(), 2u);
 }
 
 TEST(ClearBox, RefusesNaNEmptyAndInvertedBoxesChangingNothing) {
@@ -508,37 +533,6 @@ TEST(TileRemovals, TheRecordIsBoundedAndSaysWhenItForgot) {
   const std::optional<std::vector<TileIndex>> recent = map.tilesRemovedSince(map.revision() - 20);
   ASSERT_TRUE(recent.has_value());
   EXPECT_EQ(recent->size(), 7u);
-}
-
-TEST(ClearBox, PartsExactlyOneHighStayAndVolumesTouchingTheBoxAreNotChanged) {
-  // Resolution 1. Cell (0, 0): a volume [0, 10], cleared over [1, 5]: the part below, [0, 1], is
-  // exactly 1 high, not lower: it stays, with the mass in proportion (1 of 10).
-  Map map(test::unitConfig(100.0, ModelRules::paper()));
-  map.setCellVolumes({0, 0}, CellVolumes{{{0, 10, 10}}, {}});
-  EXPECT_EQ(map.clearBox({0.0, 0.0, 1.0}, {1.0, 1.0, 5.0}), 1u);
-  const CellVolumes after = map.cellVolumes({0, 0});
-  ASSERT_EQ(after.positive.size(), 2u);
-  EXPECT_TRUE(test::volumeIs(after.positive[0], 0.0, 1.0, 1.0));
-  EXPECT_TRUE(test::volumeIs(after.positive[1], 5.0, 10.0, 5.0));
-  // Cell (5, 0): volumes [0, 2] and [6, 8] only touch a box over [2, 6]: nothing of them lies
-  // within it, no cell changes.
-  map.setCellVolumes({5, 0}, CellVolumes{{{0, 2, 2}, {6, 8, 2}}, {}});
-  const std::uint64_t revision = map.revision();
-  EXPECT_EQ(map.clearBox({5.0, 0.0, 2.0}, {6.0, 1.0, 6.0}), 0u);
-  EXPECT_EQ(map.revision(), revision);
-  EXPECT_EQ(map.cellVolumes({5, 0}).positive.size(), 2u);
-}
-
-TEST(ClearBox, ABoxExactlyOneCellHighLeavesAGapOverOne) {
-  // Cut at a box exactly 1 high, the parts would lie exactly 1 apart, which Sec. III-A forbids
-  // (gaps > 1): the box is widened as a thinner one is.
-  Map map(test::unitConfig(100.0, ModelRules::paper()));
-  map.setCellVolumes({0, 0}, CellVolumes{{{0, 10, 10}}, {}});
-  EXPECT_EQ(map.clearBox({0.0, 0.0, 5.0}, {1.0, 1.0, 6.0}), 1u);
-  const CellVolumes after = map.cellVolumes({0, 0});
-  ASSERT_EQ(after.positive.size(), 2u);
-  EXPECT_GT(after.positive[1].bottom - after.positive[0].top, 1.0f);
-  EXPECT_TRUE(test::mapSatisfiesConstraints(map));
 }
 
 TEST(DropTiles, ATileAtExactlyTheRadiusStays) {

@@ -489,6 +489,26 @@ TEST(Config, MapConfigFieldsAreChecked) {
     expectConfigError([&] { Map map(config); }, field);
   }
   EXPECT_NO_THROW({ Map map(MapConfig{0.001, 4194.0, ModelRules{}}); });
+  // Each field on its own: resolution 0 with a valid max_coordinate is not reported as a
+  // max_coordinate error (whose message names the resolution too).
+  try {
+    MapConfig{0.0, 100.0, {}}.validate();
+    ADD_FAILURE() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).find("max_coordinate"), std::string::npos) << e.what();
+  }
+  // At most 4194304 cells: the bound itself is allowed.
+  EXPECT_NO_THROW((MapConfig{1.0, 4194304.0, {}}.validate()));
+  expectConfigError([] { MapConfig{1.0, 4194305.0, {}}.validate(); }, "max_coordinate");
+  // out_of_range_free_length must be > 0 (infinity for no limit).
+  for (const double length : {0.0, -1.0, kNaN}) {
+    MapConfig config;
+    config.rules.out_of_range_free_length = length;
+    expectConfigError([&] { config.validate(); }, "out_of_range_free_length");
+  }
+  MapConfig unlimited;
+  unlimited.rules.out_of_range_free_length = kInf;
+  EXPECT_NO_THROW(unlimited.validate());
 }
 
 TEST(Config, PlanningConfigFieldsAreCheckedAtTheEdgesOfTheirRanges) {
@@ -719,30 +739,6 @@ TEST(ChangeTracking, EmptyingCellsThatHoldNothingChangesNoTile) {
   map.setCellVolumes({{{5, 4}, CellVolumes{}}, {{100, 100}, CellVolumes{}}});
   EXPECT_TRUE(modifiedSince(map, revision).empty());
   EXPECT_EQ(allVolumes(map), before);
-}
-
-TEST(Config, EachMapConfigFieldIsCheckedOnItsOwn) {
-  // Resolution 0 with a valid max_coordinate: the error names resolution, not max_coordinate.
-  try {
-    MapConfig{0.0, 100.0, {}}.validate();
-    ADD_FAILURE() << "no ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()).find("max_coordinate"), std::string::npos) << e.what();
-  }
-  // At most 4194304 cells: the bound itself is allowed.
-  const MapConfig at_the_bound{1.0, 4194304.0, {}};
-  EXPECT_NO_THROW(at_the_bound.validate());
-  const MapConfig beyond_the_bound{1.0, 4194305.0, {}};
-  expectConfigError([&] { beyond_the_bound.validate(); }, "max_coordinate");
-  // out_of_range_free_length must be > 0 (infinity for no limit).
-  for (const double length : {0.0, -1.0, kNaN}) {
-    MapConfig config;
-    config.rules.out_of_range_free_length = length;
-    expectConfigError([&] { config.validate(); }, "out_of_range_free_length");
-  }
-  MapConfig unlimited;
-  unlimited.rules.out_of_range_free_length = kInf;
-  EXPECT_NO_THROW(unlimited.validate());
 }
 
 }  // namespace
