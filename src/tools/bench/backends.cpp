@@ -13,11 +13,12 @@
 #include "mvog/raster.h"
 
 namespace mvog_bench {
-namespace {
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
+
+namespace {
 
 /// Where a ray ends once truncated to max_range (both backends truncate the same way).
 Eigen::Vector3d rayEnd(const Eigen::Vector3d& origin, const Eigen::Vector3f& hit,
@@ -270,22 +271,6 @@ double StateCounts::percent(mvog::OccupancyState state) const {
                        : 100.0 * static_cast<double>(counts[stateIndex(state)]) /
                              static_cast<double>(points());
 }
-
-namespace {
-
-template <class StateOf>
-Quality qualityOf(const SamplePoints& points, StateOf&& state_of) {
-  Quality quality;
-  auto count = [&](const std::vector<Eigen::Vector3d>& at, StateCounts& into) {
-    for (const Eigen::Vector3d& p : at) ++into.counts[stateIndex(state_of(p))];
-  };
-  count(points.endpoints, quality.endpoints);
-  count(points.along_rays, quality.along_rays);
-  count(points.far_from_data, quality.far_from_data);
-  return quality;
-}
-
-}  // namespace
 
 Quality mvogQuality(const mvog::Map& map, double occupancy_threshold, const SamplePoints& points) {
   return qualityOf(points, [&](const Eigen::Vector3d& p) {

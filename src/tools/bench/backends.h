@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -26,6 +27,9 @@ struct RunOptions {
   /// MVOG only: insert the out-of-range readings too (with rules.out_of_range_free_length).
   bool out_of_range = false;
 };
+
+/// Seconds from `start` to now (steady clock): what each backend's insertion took.
+double secondsSince(std::chrono::steady_clock::time_point start);
 
 struct MvogStats {
   int threads = 1;
@@ -94,6 +98,7 @@ SamplePoints samplePoints(const InputData& input, const RunOptions& options, std
 /// How many of some points a map calls unknown, free and occupied (index: mvog::OccupancyState).
 struct StateCounts {
   std::array<std::size_t, 3> counts{};
+  void add(mvog::OccupancyState state) { ++counts[static_cast<std::size_t>(state)]; }
   std::size_t points() const { return counts[0] + counts[1] + counts[2]; }
   /// Percentage of the points in `state` (NaN without points).
   double percent(mvog::OccupancyState state) const;
@@ -106,6 +111,18 @@ struct Quality {
   StateCounts along_rays;     ///< the ray passed: free is right
   StateCounts far_from_data;  ///< nothing was seen: unknown is right
 };
+/// The quality of a map whose state at p is `state_of(p)`.
+template <class StateOf>
+Quality qualityOf(const SamplePoints& points, StateOf&& state_of) {
+  Quality quality;
+  auto count = [&](const std::vector<Eigen::Vector3d>& at, StateCounts& into) {
+    for (const Eigen::Vector3d& p : at) into.add(state_of(p));
+  };
+  count(points.endpoints, quality.endpoints);
+  count(points.along_rays, quality.along_rays);
+  count(points.far_from_data, quality.far_from_data);
+  return quality;
+}
 Quality mvogQuality(const mvog::Map& map, double occupancy_threshold, const SamplePoints& points);
 Quality octomapQuality(const octomap::OcTree& tree, const SamplePoints& points);
 

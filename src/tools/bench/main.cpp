@@ -169,10 +169,6 @@ double occupancyThreshold(const Arguments& arguments) {
                                                     : mvog::kDefaultOccupancyThreshold);
 }
 
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 /// Keeps in `fastest` the faster of it and `next` (a shared machine only ever slows a run down);
 /// every run builds the same map, so the one kept stands for all.
 template <class Run, class SecondsOf>
@@ -266,7 +262,7 @@ int main(int argc, char** argv) {
     const mvog_bench::InputData input = mvog_bench::loadInput(
         arguments.input, arguments.fixed_frame,
         std::min(arguments.max_range, arguments.rules.out_of_range_free_length));
-    report.load_seconds = secondsSince(start);
+    report.load_seconds = mvog_bench::secondsSince(start);
     mvog_bench::RunOptions sampling;
     sampling.max_range = arguments.max_range;
     const mvog_bench::SamplePoints points =
