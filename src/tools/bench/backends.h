@@ -13,13 +13,13 @@
 
 namespace mvog_bench {
 
-/// How both backends map one input.
+/// How the backends map one input.
 struct RunOptions {
   double resolution = 0.1;
-  /// Hits further than this (m) are truncated to it and insert free space only, in both
-  /// backends (OctoMap's insertPointCloud maxrange); infinity: no limit.
+  /// Hits further than this (m) are truncated to it and insert free space only, in every
+  /// backend (OctoMap's insertPointCloud maxrange); infinity: no limit.
   double max_range = 0.0;
-  int threads = 1;  ///< MVOG only; OctoMap's insertion is single-threaded
+  int threads = 1;  ///< MVOG only; OctoMap's and Bonxai's insertions are single-threaded
   /// MVOG only: the model's rules (MapConfig::rules).
   mvog::ModelRules rules;
   /// MVOG only: occupied where p is above it.

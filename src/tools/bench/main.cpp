@@ -1,6 +1,7 @@
-// mvog_bench: MVOG against OctoMap on the same rays from a ROS bag or an OctoMap scan graph.
+// mvog_bench: MVOG against OctoMap (and Bonxai, when built with it) on the same rays from a ROS
+// bag or an OctoMap scan graph.
 //   mvog_bench --input FILE [--resolution R]... [--max-range M] [--threads N] [--repeat K]
-//              [--backend mvog|octomap|walk|both|all] [--json OUT] [--fixed-frame FRAME]
+//              [--backend mvog|octomap|bonxai|walk|both|all] [--json OUT] [--fixed-frame FRAME]
 //              [--model default|paper] [--clip-free-space-at-hits on|off]
 //              [--mass-counting per-scan|per-reading] [--split-free-space-at-obstacles on|off]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "backends.h"
+#include "bonxai_backend.h"
 #include "input.h"
 #include "report.h"
 
@@ -35,7 +37,9 @@ struct Arguments {
   bool out_of_range = false;  ///< default: the rules' (the paper's for --model paper)
   bool run_mvog = false;
   bool run_octomap = false;
+  bool run_bonxai = false;
   bool run_walk = false;
+  bool bonxai_skipped = false;  ///< --backend all, built without Bonxai
   std::string json;
   std::string fixed_frame = "map";
 };
@@ -47,8 +51,8 @@ class UsageError : public std::runtime_error {
 
 constexpr const char* kUsage =
     "usage: mvog_bench --input FILE [--resolution R]... [--max-range M] [--threads N]\n"
-    "                  [--repeat K] [--backend mvog|octomap|walk|both|all] [--json OUT]\n"
-    "                  [--fixed-frame FRAME]\n"
+    "                  [--repeat K] [--backend mvog|octomap|bonxai|walk|both|all]\n"
+    "                  [--json OUT] [--fixed-frame FRAME]\n"
     "                  [--model default|paper] [--clip-free-space-at-hits on|off]\n"
     "                  [--mass-counting per-scan|per-reading]\n"
     "                  [--split-free-space-at-obstacles on|off] [--occupancy-threshold T]\n"
@@ -60,16 +64,18 @@ constexpr const char* kUsage =
     "              rotating-lidar-32, tilting-laser)\n"
     "  R           cell size in metres, repeatable (default 0.1)\n"
     "  M           hits further than M metres insert free space only, truncated (default: none)\n"
-    "  N           MVOG insertion threads (default 1; OctoMap always uses one)\n"
+    "  N           MVOG insertion threads (default 1; OctoMap and Bonxai always use one)\n"
     "  K           each backend inserts K times, the backends taking turns, and the fastest\n"
     "              run of each is reported (default 1)\n"
-    "  --backend   repeatable: mvog, octomap, walk (the bare ray walk, MVOG's floor), both\n"
-    "              (mvog and octomap, the default) or all\n"
+    "  --backend   repeatable: mvog, octomap, bonxai (only when built with Bonxai's sources,\n"
+    "              CMake's MVOG_PEERS_DIR), walk (the bare ray walk, MVOG's floor), both (mvog\n"
+    "              and octomap, the default) or all (every one built)\n"
     "  FRAME       the bag's world frame (default map)\n"
     "  T           MVOG is occupied where p > T (default: mvog::kDefaultOccupancyThreshold,\n"
     "              the paper's 0.5 with --model paper)\n"
     "  L           MVOG also inserts the out-of-range readings, freeing L m of each (OctoMap\n"
-    "              takes none: by default both backends disregard them, as the paper's Table I)\n"
+    "              and Bonxai take none: by default every backend disregards them, as the\n"
+    "              paper's Table I)\n"
     "  --model     MVOG's rules: the defaults, or the paper's exact model; the options after\n"
     "              it change one rule each (mvog::ModelRules, README's decisions table)\n";
 
@@ -117,12 +123,18 @@ Arguments parseArguments(int argc, char** argv) {
     } else if (option == "--repeat") {
       arguments.repeat = wholeNumber(option, value, 100);
     } else if (option == "--backend") {
-      if (value != "mvog" && value != "octomap" && value != "walk" && value != "both" &&
-          value != "all") {
-        throw UsageError("--backend must be mvog, octomap, walk, both or all, got '" + value + "'");
+      if (value != "mvog" && value != "octomap" && value != "bonxai" && value != "walk" &&
+          value != "both" && value != "all") {
+        throw UsageError("--backend must be mvog, octomap, bonxai, walk, both or all, got '" +
+                         value + "'");
+      }
+      if (value == "bonxai" && !mvog_bench::kBonxaiBuilt) {
+        throw UsageError(mvog_bench::kBonxaiMissing);
       }
       arguments.run_mvog |= value == "mvog" || value == "both" || value == "all";
       arguments.run_octomap |= value == "octomap" || value == "both" || value == "all";
+      arguments.run_bonxai |= (value == "bonxai" || value == "all") && mvog_bench::kBonxaiBuilt;
+      arguments.bonxai_skipped |= value == "all" && !mvog_bench::kBonxaiBuilt;
       arguments.run_walk |= value == "walk" || value == "all";
     } else if (option == "--occupancy-threshold") {
       const double threshold = positiveNumber(option, value);
@@ -192,6 +204,7 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
   std::optional<mvog_bench::MvogRun> mvog;
   std::optional<mvog_bench::OctomapRun> octomap;
+  std::optional<mvog_bench::BonxaiRun> bonxai;
   // The backends take turns, one insertion each a round, so that a slow spell of a shared
   // machine falls on all of them alike rather than on the repeats of one: the ratios of their
   // fastest insertions are then measured over the same time.
@@ -203,6 +216,12 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
     if (arguments.run_octomap) {
       keepFaster(octomap, mvog_bench::runOctomap(input, options),
                  [](const mvog_bench::OctomapRun& r) { return r.stats.insert_seconds; });
+    }
+    if constexpr (mvog_bench::kBonxaiBuilt) {  // runBonxai is defined only then
+      if (arguments.run_bonxai) {
+        keepFaster(bonxai, mvog_bench::runBonxai(input, options),
+                   [](const mvog_bench::BonxaiRun& r) { return r.stats.insert_seconds; });
+      }
     }
     if (arguments.run_walk) {
       keepFaster(report.walk, mvog_bench::runWalk(input, options),
@@ -218,6 +237,10 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
     std::fprintf(stderr, "mvog_bench: %.3f m: octomap inserted in %.3f s\n", resolution,
                  octomap->stats.insert_seconds);
   }
+  if (bonxai) {
+    std::fprintf(stderr, "mvog_bench: %.3f m: bonxai inserted in %.3f s\n", resolution,
+                 bonxai->stats.insert_seconds);
+  }
   if (report.walk) {
     std::fprintf(stderr, "mvog_bench: %.3f m: the bare walk took %.3f s\n", resolution,
                  report.walk->insert_seconds);
@@ -226,6 +249,12 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
     report.mvog_quality = mvog_bench::mvogQuality(mvog->map, options.occupancy_threshold, points);
   }
   if (octomap) report.octomap_quality = mvog_bench::octomapQuality(*octomap->tree, points);
+  if constexpr (mvog_bench::kBonxaiBuilt) {  // bonxaiQuality is defined only then
+    if (bonxai) {
+      report.bonxai = bonxai->stats;
+      report.bonxai_quality = mvog_bench::bonxaiQuality(*bonxai->map, points);
+    }
+  }
   if (mvog && octomap) {
     report.agreement =
         mvog_bench::compareMaps(points, mvog->map, options.occupancy_threshold, *octomap->tree);
@@ -248,6 +277,10 @@ int main(int argc, char** argv) {
     if (!help) std::fprintf(stderr, "mvog_bench: %s\n", e.what());
     std::fputs(kUsage, help ? stdout : stderr);
     return help ? 0 : 2;
+  }
+  if (arguments.bonxai_skipped) {
+    std::fprintf(stderr, "mvog_bench: --backend all skips Bonxai: %s\n",
+                 mvog_bench::kBonxaiMissing);
   }
   try {
     mvog_bench::BenchReport report;

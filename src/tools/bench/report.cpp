@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <cinttypes>
 #include <cmath>
 #include <fstream>
@@ -134,6 +135,33 @@ JsonObject octomapJson(double resolution, std::size_t readings, const OctomapSta
   return o;
 }
 
+JsonObject bonxaiJson(double resolution, std::size_t readings, const BonxaiStats& s) {
+  JsonObject o;
+  o.add("backend", "bonxai")
+      .add("resolution", resolution)
+      .add("readings", readings)
+      .add("insert_seconds", s.insert_seconds)
+      .add("readings_per_second", perSecond(readings, s.insert_seconds))
+      .add("memory_bytes", s.memory_bytes)
+      .add("threads", 1)
+      .add("active_cells", s.active_cells);
+  return o;
+}
+
+/// Each backend's name and its quality at one resolution (empty: not run).
+std::array<std::pair<const char*, const std::optional<Quality>*>, 3> qualities(
+    const ResolutionReport& r) {
+  return {
+      {{"mvog", &r.mvog_quality}, {"octomap", &r.octomap_quality}, {"bonxai", &r.bonxai_quality}}};
+}
+
+/// MVOG's speed and memory over Bonxai's: readings per second, bytes held.
+std::pair<double, double> mvogOverBonxai(const MvogStats& mvog, const BonxaiStats& bonxai) {
+  return {
+      ratio(bonxai.insert_seconds, mvog.insert_seconds),
+      ratio(static_cast<double>(mvog.memory.bytes_held), static_cast<double>(bonxai.memory_bytes))};
+}
+
 JsonObject agreementJson(const StateAgreement& a) {
   std::string matrix = "{";
   for (std::size_t m = 0; m < 3; ++m) {
@@ -192,7 +220,7 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                "%zu non-finite points; skipped messages: %zu without transform, %zu without "
                "camera info, %zu malformed\n",
                readings, input.scans.size(), input.sensor_messages, input.out_of_range_readings,
-               report.out_of_range ? "given to MVOG only" : "disregarded by both backends",
+               report.out_of_range ? "given to MVOG only" : "disregarded by every backend",
                input.skipped_beams, input.skipped_pixels, input.non_finite_points,
                input.without_transform, input.without_camera_info, input.invalid_messages);
   if (std::isfinite(report.max_range)) {
@@ -223,6 +251,11 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                    perSecond(readings, r.octomap->insert_seconds), r.octomap->memory_bytes,
                    r.octomap->binary_file_bytes, r.octomap->full_file_bytes);
     }
+    if (r.bonxai) {
+      std::fprintf(out, "%-8s %7.3f %7d %10zu %10.3f %12.0f %14zu %14s %14s\n", "bonxai",
+                   r.resolution, 1, readings, r.bonxai->insert_seconds,
+                   perSecond(readings, r.bonxai->insert_seconds), r.bonxai->memory_bytes, "-", "-");
+    }
     if (r.walk) {
       std::fprintf(out, "%-8s %7.3f %7d %10zu %10.3f %12.0f %14s %14s %14s\n", "walk", r.resolution,
                    1, readings, r.walk->insert_seconds, perSecond(readings, r.walk->insert_seconds),
@@ -232,8 +265,7 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
 
   bool quality_header = false;
   for (const ResolutionReport& r : report.resolutions) {
-    for (const auto& [name, quality] :
-         {std::make_pair("mvog", &r.mvog_quality), std::make_pair("octomap", &r.octomap_quality)}) {
+    for (const auto& [name, quality] : qualities(r)) {
       if (!*quality) continue;
       if (!quality_header) {
         std::fprintf(out,
@@ -297,14 +329,26 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                  percent(r.agreement->endpoints).c_str(), percent(r.agreement->along_rays).c_str(),
                  r.agreement->sampled_rays);
   }
+
+  bool bonxai_header = false;
+  for (const ResolutionReport& r : report.resolutions) {
+    if (!r.mvog || !r.bonxai) continue;
+    if (!bonxai_header) {
+      std::fprintf(out, "\nMVOG / Bonxai\n%7s %12s %14s\n", "res (m)", "readings/s", "memory held");
+      bonxai_header = true;
+    }
+    const auto [speed, memory] = mvogOverBonxai(*r.mvog, *r.bonxai);
+    std::fprintf(out, "%7.3f %11.2fx %13.3fx\n", r.resolution, speed, memory);
+  }
 }
 
 void writeJson(const BenchReport& report, const InputData& input, const std::string& path) {
   const std::size_t readings = input.readings();
-  std::vector<JsonObject> results, table_one, comparison, agreement, quality;
+  std::vector<JsonObject> results, table_one, comparison, agreement, quality, bonxai_comparison;
   for (const ResolutionReport& r : report.resolutions) {
     if (r.mvog) results.push_back(mvogJson(r.resolution, readings, *r.mvog));
     if (r.octomap) results.push_back(octomapJson(r.resolution, readings, *r.octomap));
+    if (r.bonxai) results.push_back(bonxaiJson(r.resolution, readings, *r.bonxai));
     if (r.walk) {
       JsonObject walk;
       walk.add("backend", "walk")
@@ -317,8 +361,7 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
         walk.add("mvog_time_ratio", ratio(r.mvog->insert_seconds, r.walk->insert_seconds));
       results.push_back(walk);
     }
-    for (const auto& [name, q] :
-         {std::make_pair("mvog", &r.mvog_quality), std::make_pair("octomap", &r.octomap_quality)}) {
+    for (const auto& [name, q] : qualities(r)) {
       if (!*q) continue;
       JsonObject row;
       row.add("backend", name)
@@ -342,6 +385,14 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
     if (r.octomap) row.add("octomap_bytes", r.octomap->memory_bytes);
     if (r.mvog) row.add("mvog_bytes", r.mvog->memory.table_one_bytes);
     table_one.push_back(row);
+    if (r.mvog && r.bonxai) {
+      const auto [speed, memory] = mvogOverBonxai(*r.mvog, *r.bonxai);
+      JsonObject ratios;
+      ratios.add("resolution", r.resolution)
+          .add("readings_per_second_ratio", speed)
+          .add("memory_ratio", memory);
+      bonxai_comparison.push_back(ratios);
+    }
     if (!r.mvog || !r.octomap) continue;
     JsonObject ratios;
     ratios.add("resolution", r.resolution)
@@ -385,7 +436,8 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
       .add("table_one", table_one)
       .add("quality", quality)
       .add("comparison", comparison)
-      .add("agreement", agreement);
+      .add("agreement", agreement)
+      .add("bonxai_comparison", bonxai_comparison);
 
   const std::string temporary = path + ".tmp." + std::to_string(::getpid());
   {

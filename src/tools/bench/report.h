@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "backends.h"
+#include "bonxai_backend.h"
 #include "input.h"
 
 namespace mvog_bench {
@@ -16,10 +17,12 @@ struct ResolutionReport {
   std::size_t voxel_grid_cells = 0;  ///< boundingBoxVoxels()
   std::optional<MvogStats> mvog;
   std::optional<OctomapStats> octomap;
+  std::optional<BonxaiStats> bonxai;
   std::optional<WalkStats> walk;
   std::optional<Quality> mvog_quality;
   std::optional<Quality> octomap_quality;
-  std::optional<Agreement> agreement;  ///< when both backends ran
+  std::optional<Quality> bonxai_quality;
+  std::optional<Agreement> agreement;  ///< when MVOG and OctoMap ran
 };
 
 struct BenchReport {
@@ -33,13 +36,14 @@ struct BenchReport {
   std::vector<ResolutionReport> resolutions;
 };
 
-/// The readable tables: per backend and resolution, Table I, MVOG / OctoMap ratios, agreement.
+/// The readable tables: per backend and resolution, Table I, MVOG / OctoMap ratios, agreement,
+/// MVOG / Bonxai ratios.
 void printReport(const BenchReport& report, const InputData& input, std::FILE* out);
 
 /// {"results": [{"backend", "resolution", "readings", "insert_seconds", "readings_per_second",
 /// "memory_bytes", "file_bytes", ...}, ...], "input": {...}, "table_one": [...],
-/// "comparison": [...], "agreement": [...]}, written atomically (temporary file, then rename).
-/// Throws std::runtime_error if it cannot be written.
+/// "comparison": [...], "agreement": [...], "bonxai_comparison": [...]}, written atomically
+/// (temporary file, then rename). Throws std::runtime_error if it cannot be written.
 void writeJson(const BenchReport& report, const InputData& input, const std::string& path);
 
 }  // namespace mvog_bench

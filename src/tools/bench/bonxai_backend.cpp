@@ -1,0 +1,33 @@
+#include "bonxai_backend.h"
+
+#include <chrono>
+#include <utility>
+
+#include <bonxai_map/probabilistic_map.hpp>
+
+namespace mvog_bench {
+
+BonxaiRun runBonxai(const InputData& input, const RunOptions& options) {
+  auto map = std::make_shared<Bonxai::ProbabilisticMap>(options.resolution);
+  // An infinite max_range truncates nothing: Bonxai compares squared lengths with its square.
+  const auto start = std::chrono::steady_clock::now();
+  for (const mvog::Scan& scan : input.scans) {
+    map->insertPointCloud(scan.hits, Eigen::Vector3f(scan.origin.cast<float>()), options.max_range);
+  }
+  BonxaiRun run;
+  run.stats.insert_seconds = secondsSince(start);
+  run.stats.memory_bytes = map->grid().memUsage();
+  run.stats.active_cells = map->grid().activeCellsCount();
+  run.map = std::move(map);
+  return run;
+}
+
+Quality bonxaiQuality(const Bonxai::ProbabilisticMap& map, const SamplePoints& points) {
+  return qualityOf(points, [&](const Eigen::Vector3d& p) {
+    const Bonxai::CoordT voxel = map.grid().posToCoord(p.x(), p.y(), p.z());
+    if (map.isOccupied(voxel)) return mvog::OccupancyState::kOccupied;
+    return map.isFree(voxel) ? mvog::OccupancyState::kFree : mvog::OccupancyState::kUnknown;
+  });
+}
+
+}  // namespace mvog_bench
