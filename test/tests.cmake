@@ -148,5 +148,9 @@ if(TARGET mvog_bench)
   target_compile_definitions(test_mvog_bench PRIVATE
     MVOG_BENCH_EXECUTABLE="$<TARGET_FILE:mvog_bench>"
     MVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  # Which of its Bonxai cases applies: the backend's line, or the message without it.
+  if(MVOG_BENCH_HAVE_BONXAI)
+    target_compile_definitions(test_mvog_bench PRIVATE MVOG_BENCH_HAVE_BONXAI=1)
+  endif()
   add_dependencies(test_mvog_bench mvog_bench)
 endif()

@@ -1,7 +1,8 @@
 // Smoke test of mvog_bench: behaviour only (never timings). Runs the executable on
 // spherical_scan.graph from the shared data (MVOG_DATA_DIR, default ../shared/data beside the
 // repository; skipped when absent unless CI=true), on scan graphs and a bag of depth images it
-// writes itself, on its synthetic sensors, and on bad input.
+// writes itself, on its synthetic sensors, and on bad input; Bonxai's backend when mvog_bench was
+// built with it (MVOG_BENCH_HAVE_BONXAI), else its message.
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -39,17 +41,25 @@ class BenchSmokeTest : public ::testing::Test {
     EXPECT_EQ(std::system(command.c_str()), 0);
   }
 
-  /// Runs mvog_bench with `arguments`; returns its exit code, its stderr in `errors`.
-  int runBench(const std::string& arguments, std::string& errors) const {
+  /// Runs mvog_bench with `arguments`; returns its exit code, its stderr in `errors` (and its
+  /// stdout in `*output` if given).
+  int runBench(const std::string& arguments, std::string& errors,
+               std::string* output = nullptr) const {
     const std::string error_file = directory_ + "/stderr.txt";
+    const std::string output_file = directory_ + "/stdout.txt";
     const std::string command = std::string("'") + MVOG_BENCH_EXECUTABLE + "' " + arguments +
-                                " > /dev/null 2> '" + error_file + "'";
+                                " > '" + output_file + "' 2> '" + error_file + "'";
     const int status = std::system(command.c_str());
-    std::ifstream file(error_file);
+    errors = readText(error_file);
+    if (output != nullptr) *output = readText(output_file);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  static std::string readText(const std::string& path) {
+    std::ifstream file(path);
     std::stringstream text;
     text << file.rdbuf();
-    errors = text.str();
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return text.str();
   }
 
   Json::Value readJson(const std::string& path) const {
@@ -186,6 +196,64 @@ TEST_F(BenchSmokeTest, SyntheticSensorsKeepWhatTheySawAsOctoMapDoes) {
   EXPECT_NE(errors.find("no such synthetic input (there are rotating-lidar-16"), std::string::npos)
       << errors;
 }
+
+#ifdef MVOG_BENCH_HAVE_BONXAI
+// Bonxai's map is OctoMap's model (the same hit and miss log-odds, a voxel updated once a scan):
+// on the same rays it keeps what the sensor saw as OctoMap does, and knows nothing far from them.
+TEST_F(BenchSmokeTest, BonxaiMapsTheSameRaysAsOctoMap) {
+  const std::string json = directory_ + "/bonxai.json";
+  std::string errors;
+  std::string output;
+  ASSERT_EQ(runBench("--input synthetic:tilting-laser --resolution 0.1 --backend both "
+                     "--backend bonxai --json '" +
+                         json + "'",
+                     errors, &output),
+            0)
+      << errors;
+  EXPECT_NE(output.find("\nbonxai     0.100       1 "), std::string::npos) << output;
+  EXPECT_NE(output.find("\nMVOG / Bonxai\n"), std::string::npos) << output;
+  const Json::Value root = readJson(json);
+  Json::Value bonxai;
+  for (const Json::Value& result : root["results"]) {
+    if (result["backend"].asString() == "bonxai") bonxai = result;
+  }
+  ASSERT_FALSE(bonxai.isNull());
+  EXPECT_EQ(bonxai["readings"].asUInt64(), root["input"]["readings"].asUInt64());
+  EXPECT_GT(bonxai["insert_seconds"].asDouble(), 0.0);
+  EXPECT_GT(bonxai["memory_bytes"].asUInt64(), 0u);
+  EXPECT_GT(bonxai["active_cells"].asUInt64(), 0u);
+  std::map<std::string, Json::Value> quality;
+  for (const Json::Value& row : root["quality"]) quality[row["backend"].asString()] = row;
+  ASSERT_EQ(quality.count("bonxai"), 1u);
+  ASSERT_EQ(quality.count("octomap"), 1u);
+  for (const char* key : {"endpoints_occupied_percent", "along_rays_free_percent"}) {
+    EXPECT_NEAR(quality["bonxai"][key].asDouble(), quality["octomap"][key].asDouble(), 2.0) << key;
+  }
+  EXPECT_GE(quality["bonxai"]["far_unknown_percent"].asDouble(), 99.0);
+  ASSERT_EQ(root["bonxai_comparison"].size(), 1u);
+  EXPECT_GT(root["bonxai_comparison"][0]["readings_per_second_ratio"].asDouble(), 0.0);
+  EXPECT_GT(root["bonxai_comparison"][0]["memory_ratio"].asDouble(), 0.0);
+}
+#else
+TEST_F(BenchSmokeTest, WithoutBonxaiSaysWhyAndAllRunsTheOthers) {
+  std::string errors;
+  EXPECT_EQ(runBench("--input synthetic:tilting-laser --backend bonxai", errors), 2);
+  EXPECT_NE(errors.find("mvog_bench was built without Bonxai"), std::string::npos) << errors;
+  EXPECT_NE(errors.find("MVOG_PEERS_DIR"), std::string::npos) << errors;
+  const std::string json = directory_ + "/all.json";
+  ASSERT_EQ(runBench("--input synthetic:tilting-laser --resolution 0.1 --backend all --json '" +
+                         json + "'",
+                     errors),
+            0)
+      << errors;
+  EXPECT_NE(errors.find("--backend all skips Bonxai: mvog_bench was built without Bonxai"),
+            std::string::npos)
+      << errors;
+  const Json::Value root = readJson(json);
+  EXPECT_EQ(root["results"].size(), 3u);  // mvog, octomap and the walk
+  EXPECT_EQ(root["bonxai_comparison"].size(), 0u);
+}
+#endif
 
 /// A depth image of `width` x `height` pixels of `encoding` (Pixel: std::uint16_t for 16UC1,
 /// float for 32FC1), every pixel `depth`, at `seconds`.
