@@ -24,8 +24,32 @@ def by_backend(run):
     """An mvog_bench run's MVOG and OctoMap quality, each backend's results and the comparison,
     each by resolution."""
     return (by_resolution(run["quality"], "mvog"), by_resolution(run["quality"], "octomap"),
-            {b: by_resolution(run["results"], b) for b in ("mvog", "octomap", "walk")},
+            {b: by_resolution(run["results"], b) for b in ("mvog", "octomap", "bonxai", "walk")},
             by_resolution(run["comparison"]))
+
+
+BONXAI_QUALITY = ["ends occupied: Bonxai", "along free: Bonxai", "far unknown: Bonxai"]
+BONXAI_SPEED = ["Bonxai (s)", "MVOG / Bonxai speed"]
+BONXAI_MEMORY = ["Bonxai held", "MVOG / Bonxai memory"]
+
+
+def bonxai_columns(run, resolution):
+    """Bonxai's figures at one resolution of an mvog_bench run, when it ran (mvog_bench built with
+    MVOG_PEERS_DIR): its quality, time, memory and MVOG / Bonxai ratios, each a table cell."""
+    quality = by_resolution(run["quality"], "bonxai").get(resolution)
+    result = by_resolution(run["results"], "bonxai").get(resolution)
+    ratios = by_resolution(run.get("bonxai_comparison", [])).get(resolution)
+    if not (quality and result and ratios):
+        return dict.fromkeys(BONXAI_QUALITY + BONXAI_SPEED + BONXAI_MEMORY, "-")
+    return {
+        "ends occupied: Bonxai": percent(quality["endpoints_occupied_percent"]),
+        "along free: Bonxai": percent(quality["along_rays_free_percent"]),
+        "far unknown: Bonxai": percent(quality["far_unknown_percent"]),
+        "Bonxai (s)": f"{result['insert_seconds']:.3f}",
+        "MVOG / Bonxai speed": f"{ratios['readings_per_second_ratio']:.2f}x",
+        "Bonxai held": megabytes(result["memory_bytes"]),
+        "MVOG / Bonxai memory": f"{ratios['memory_ratio']:.3f}x",
+    }
 
 
 def file_name(path, prefix):
@@ -97,6 +121,8 @@ def main(out):
         sys.exit(f"benchmark_tables.py: no all_*.json in {out}")
 
     quality, speed, memory, threads = [], [], [], []
+    # Bonxai's columns when some run has them (mvog_bench built with MVOG_PEERS_DIR).
+    with_bonxai = any(run.get("bonxai_comparison") for run in runs.values())
     for name, run in runs.items():
         mvog_quality, octomap_quality, results, comparison = by_backend(run)
         paper_quality = by_resolution(paper[name]["quality"], "mvog") if name in paper else {}
@@ -104,6 +130,7 @@ def main(out):
         for resolution in sorted(mvog_quality, reverse=True):
             m, o = mvog_quality[resolution], octomap_quality[resolution]
             p = paper_quality.get(resolution)
+            bonxai = bonxai_columns(run, resolution)
             quality.append([
                 name, f"{resolution:g}",
                 percent(m["endpoints_occupied_percent"]), percent(o["endpoints_occupied_percent"]),
@@ -111,7 +138,7 @@ def main(out):
                 percent(m["along_rays_free_percent"]), percent(o["along_rays_free_percent"]),
                 percent(p["along_rays_free_percent"]) if p else "-",
                 percent(m["far_unknown_percent"]), percent(o["far_unknown_percent"]),
-            ])
+            ] + ([bonxai[c] for c in BONXAI_QUALITY] if with_bonxai else []))
             mv, oc, walk = (results[b][resolution] for b in ("mvog", "octomap", "walk"))
             speed.append([
                 name, f"{resolution:g}", f"{mv['readings']:,}",
@@ -120,14 +147,14 @@ def main(out):
                 f"{mv['readings_per_second'] / 1e6:.2f}",
                 f"{comparison[resolution]['readings_per_second_ratio']:.1f}x",
                 f"{walk['mvog_time_ratio']:.2f}x",
-            ])
+            ] + ([bonxai[c] for c in BONXAI_SPEED] if with_bonxai else []))
             memory.append([
                 name, f"{resolution:g}", megabytes(mv["memory_bytes"]),
                 megabytes(oc["memory_bytes"]), f"{comparison[resolution]['memory_ratio']:.3f}x",
                 megabytes(table_one[resolution]["mvog_bytes"]),
                 megabytes(table_one[resolution]["octomap_bytes"]),
                 megabytes(mv["file_bytes"]), megabytes(oc["full_file_bytes"]),
-            ])
+            ] + ([bonxai[c] for c in BONXAI_MEMORY] if with_bonxai else []))
         if name in threaded:
             one, two = (fastest(threaded[name][t]) for t in (1, 2))
             checksums = {r["map_checksum"] for t in (1, 2) for r in threaded[name][t]}
@@ -147,14 +174,16 @@ def main(out):
           "insertion(s) per backend.\n")
     print("### Quality (% of the sampled points)\n")
     print(table(["file", "res (m)", "ends occupied: MVOG", "OctoMap", "paper model",
-                 "along free: MVOG", "OctoMap", "paper model", "far unknown: MVOG", "OctoMap"],
-                quality))
+                 "along free: MVOG", "OctoMap", "paper model", "far unknown: MVOG", "OctoMap"] +
+                (BONXAI_QUALITY if with_bonxai else []), quality))
     print("\n### Speed (one thread)\n")
     print(table(["file", "res (m)", "readings", "MVOG (s)", "OctoMap (s)", "walk (s)",
-                 "MVOG M readings/s", "MVOG / OctoMap speed", "MVOG / walk time"], speed))
+                 "MVOG M readings/s", "MVOG / OctoMap speed", "MVOG / walk time"] +
+                (BONXAI_SPEED if with_bonxai else []), speed))
     print("\n### Memory (MB)\n")
     print(table(["file", "res (m)", "MVOG held", "OctoMap held (pruned)", "MVOG / OctoMap",
-                 "Table I: MVOG", "Table I: OctoMap", "MVOG file", "OctoMap .ot file"], memory))
+                 "Table I: MVOG", "Table I: OctoMap", "MVOG file", "OctoMap .ot file"] +
+                (BONXAI_MEMORY if with_bonxai else []), memory))
     print("\n### Threads (0.05 m)\n")
     print(table(["file", "1 thread (s)", "2 threads (s)", "speed-up", "same map"], threads))
     other_resolutions = {file_name(p, "resolutions_"): load(p)

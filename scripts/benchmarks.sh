@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every figure of BENCHMARKS.md, from a fresh clone: installs what is missing, builds (Release),
 # runs mvog_bench on every shared recording (MVOG, OctoMap and the bare walk on the same rays, in
-# one run per file), MVOG with 2 threads, with the paper's model and with each of its rules
+# one run per file, and Bonxai when mvog_bench was built with it: MVOG_PEERS_DIR, default
+# ../shared/peers beside the repository), MVOG with 2 threads, with the paper's model and with each of its rules
 # changed alone (README's decisions table: the quality each default buys), its synthetic sensors
 # (data none of the recordings has), mvog_microbench, and the
 # instruction counts of the three insertions (callgrind: the ratios the machine's load cannot
@@ -52,6 +53,8 @@ for file in "${FILES[@]}"; do
   run_bench "paper_$file" --input "$MVOG_DATA_DIR/$file" "${RESOLUTION_OPTIONS[@]}" --backend mvog \
     --model paper
 done
+# Built without Bonxai, every run of all the backends runs without it: say so once, and why.
+grep -h -m 1 "skips Bonxai" "$OUT"/all_*.log | head -n 1 >&2 || true
 # One and two threads in turn, a process each, three rounds, before the runs that hold gigabytes
 # (OctoMap at 0.02 m, after which two threads ran up to 1.4x slower for a while): a slow spell of
 # the machine falls on both alike, and the table compares the fastest of each.
