@@ -66,7 +66,9 @@ lint changelog changelog_matches_version
 
 # The sources are compiled through the workspace's link to the repository: the header filter
 # keeps the findings to our own headers (not the generated message headers in devel/); the
-# .clang-tidy found beside the sources through that link sets the checks.
+# .clang-tidy found beside the sources through that link sets the checks. The file regex keeps
+# to our sources: Bonxai's, which mvog_bench compiles from MVOG_PEERS_DIR (../shared/peers), have
+# compile commands too, outside the repository, and are not linted.
 clang_tidy() {
   local findings
   findings=$(run-clang-tidy-14 -quiet -j 2 -p "$WORKSPACE/build" \
