@@ -96,14 +96,21 @@ class JsonObject {
   std::vector<std::pair<std::string, std::string>> entries_;
 };
 
-JsonObject mvogJson(double resolution, std::size_t readings, const MvogStats& s) {
+/// The keys every backend's result starts with.
+JsonObject resultJson(const char* backend, double resolution, std::size_t readings,
+                      double insert_seconds) {
   JsonObject o;
-  o.add("backend", "mvog")
+  o.add("backend", backend)
       .add("resolution", resolution)
       .add("readings", readings)
-      .add("insert_seconds", s.insert_seconds)
-      .add("readings_per_second", perSecond(readings, s.insert_seconds))
-      .add("memory_bytes", s.memory.bytes_held)
+      .add("insert_seconds", insert_seconds)
+      .add("readings_per_second", perSecond(readings, insert_seconds));
+  return o;
+}
+
+JsonObject mvogJson(double resolution, std::size_t readings, const MvogStats& s) {
+  JsonObject o = resultJson("mvog", resolution, readings, s.insert_seconds);
+  o.add("memory_bytes", s.memory.bytes_held)
       .add("file_bytes", s.file_bytes)
       .add("threads", s.threads)
       .add("table_one_bytes", s.memory.table_one_bytes)
@@ -120,13 +127,8 @@ JsonObject mvogJson(double resolution, std::size_t readings, const MvogStats& s)
 }
 
 JsonObject octomapJson(double resolution, std::size_t readings, const OctomapStats& s) {
-  JsonObject o;
-  o.add("backend", "octomap")
-      .add("resolution", resolution)
-      .add("readings", readings)
-      .add("insert_seconds", s.insert_seconds)
-      .add("readings_per_second", perSecond(readings, s.insert_seconds))
-      .add("memory_bytes", s.memory_bytes)
+  JsonObject o = resultJson("octomap", resolution, readings, s.insert_seconds);
+  o.add("memory_bytes", s.memory_bytes)
       .add("file_bytes", s.binary_file_bytes)
       .add("threads", 1)
       .add("full_file_bytes", s.full_file_bytes)
@@ -136,15 +138,8 @@ JsonObject octomapJson(double resolution, std::size_t readings, const OctomapSta
 }
 
 JsonObject bonxaiJson(double resolution, std::size_t readings, const BonxaiStats& s) {
-  JsonObject o;
-  o.add("backend", "bonxai")
-      .add("resolution", resolution)
-      .add("readings", readings)
-      .add("insert_seconds", s.insert_seconds)
-      .add("readings_per_second", perSecond(readings, s.insert_seconds))
-      .add("memory_bytes", s.memory_bytes)
-      .add("threads", 1)
-      .add("active_cells", s.active_cells);
+  JsonObject o = resultJson("bonxai", resolution, readings, s.insert_seconds);
+  o.add("memory_bytes", s.memory_bytes).add("threads", 1).add("active_cells", s.active_cells);
   return o;
 }
 
@@ -350,13 +345,8 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
     if (r.octomap) results.push_back(octomapJson(r.resolution, readings, *r.octomap));
     if (r.bonxai) results.push_back(bonxaiJson(r.resolution, readings, *r.bonxai));
     if (r.walk) {
-      JsonObject walk;
-      walk.add("backend", "walk")
-          .add("resolution", r.resolution)
-          .add("readings", readings)
-          .add("insert_seconds", r.walk->insert_seconds)
-          .add("readings_per_second", perSecond(readings, r.walk->insert_seconds))
-          .add("cell_visits", r.walk->cell_visits);
+      JsonObject walk = resultJson("walk", r.resolution, readings, r.walk->insert_seconds);
+      walk.add("cell_visits", r.walk->cell_visits);
       if (r.mvog)
         walk.add("mvog_time_ratio", ratio(r.mvog->insert_seconds, r.walk->insert_seconds));
       results.push_back(walk);
