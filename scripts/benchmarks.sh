@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Every figure of BENCHMARKS.md, from a fresh clone: installs what is missing, builds (Release),
 # runs mvog_bench on every shared recording (MVOG, OctoMap and the bare walk on the same rays, in
-# one run per file, and Bonxai when mvog_bench was built with it: MVOG_PEERS_DIR, default
-# ../shared/peers beside the repository), MVOG with 2 threads, with the paper's model and with each of its rules
-# changed alone (README's decisions table: the quality each default buys), its synthetic sensors
+# one run per file, and Bonxai from MVOG_PEERS_DIR, default ../shared/peers beside the
+# repository, when its sources are there), MVOG with 2 threads, with the paper's model and with
+# each of its rules changed alone (README's decisions table: the quality each default buys), its synthetic sensors
 # (data none of the recordings has), mvog_microbench, and the
 # instruction counts of the three insertions (callgrind: the ratios the machine's load cannot
 # disturb); writes the outputs (JSON and text) to OUT and prints the report's tables
@@ -15,6 +15,7 @@ source "$(dirname "$0")/common.sh"
 
 OUT=${1:-$WORKSPACE/benchmarks}
 REPEAT=${MVOG_BENCH_REPEAT:-3}
+export MVOG_PEERS_DIR=${MVOG_PEERS_DIR:-$(cd "$REPO/.." && pwd)/shared/peers}
 install_missing_packages
 build_workspace
 source_workspace
