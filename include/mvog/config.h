@@ -91,6 +91,21 @@ struct MapConfig {
   void validate() const;
 };
 
+/// Which rays of a scan are walked for free space (Sec. III-B.1).
+enum class FreeSpaceRays : std::uint8_t {
+  /// Every reading's ray (the paper).
+  kEveryReading,
+  /// With MassCounting::kPerScan, one ray per end voxel: the readings of a scan that end in one
+  /// cell at one height cell (and alike in being a hit or not) free space along one ray, to the
+  /// voxel's centre; each hit still adds its own positive volume (eq. 5). A scan adds density 1
+  /// once over the union of the heights its readings saw in a column, so the rays of a voxel,
+  /// at most a cell's diagonal apart, add little to one another's union; a depth camera at 1-4 m
+  /// puts tens to hundreds of pixels in a voxel. OctoMap's discretize option and Bonxai cast
+  /// once per end voxel too. With MassCounting::kPerReading every reading adds its own mass and
+  /// every ray is walked.
+  kOnePerEndVoxel,
+};
+
 /// How readings are turned into volumes (Sec. III-B).
 struct InsertionConfig {
   /// Obstacle readings closer than this to the sensor (m) are dropped.
@@ -104,6 +119,9 @@ struct InsertionConfig {
   bool model_negative_space = true;
   /// Threads used by Map::insertScan; the resulting map is identical for any count.
   int insertion_threads = 1;
+  /// See FreeSpaceRays (the README's decisions table: measured agreement with every reading's
+  /// walk in BENCHMARKS.md).
+  FreeSpaceRays free_space_rays = FreeSpaceRays::kOnePerEndVoxel;
 
   /// Throws ConfigError naming the first invalid field.
   void validate() const;

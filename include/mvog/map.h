@@ -45,6 +45,9 @@ struct InsertionResult {
   std::size_t rejected_out_of_bounds = 0;  ///< beyond MapConfig::max_coordinate
   std::size_t rejected_too_close = 0;      ///< hits nearer than min_range
   std::size_t ignored_out_of_range = 0;    ///< out-of-range readings with insert_out_of_range off
+  /// Rays walked for free space: one per inserted reading, or one per end voxel
+  /// (FreeSpaceRays::kOnePerEndVoxel); not a count of readings.
+  std::size_t rays_walked = 0;
   /// Time spent rasterising the obstacle readings and the out-of-range readings (thread time,
   /// summed over the insertion's threads): how much the readings without a return cost.
   double obstacle_seconds = 0.0;

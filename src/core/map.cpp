@@ -33,6 +33,7 @@ InsertionResult& InsertionResult::operator+=(const InsertionResult& other) {
   rejected_out_of_bounds += other.rejected_out_of_bounds;
   rejected_too_close += other.rejected_too_close;
   ignored_out_of_range += other.ignored_out_of_range;
+  rays_walked += other.rays_walked;
   obstacle_seconds += other.obstacle_seconds;
   out_of_range_seconds += other.out_of_range_seconds;
   return *this;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -344,6 +345,85 @@ class alignas(kCacheLine) ScanScratch {
   Volume level_volume_{};
 };
 
+/// The voxel a reading's ray ends in (grid units: its cell, and the floor of its height), and
+/// whether it ends in an obstacle (FreeSpaceRays::kOnePerEndVoxel).
+struct EndVoxel {
+  std::int32_t x;
+  std::int32_t y;
+  std::int32_t z;
+  bool obstacle;
+  friend bool operator==(const EndVoxel& a, const EndVoxel& b) {
+    return a.x == b.x && a.y == b.y && a.z == b.z && a.obstacle == b.obstacle;
+  }
+};
+
+/// The fewest readings of a scan ending in one voxel for which one ray is walked
+/// (FreeSpaceRays::kOnePerEndVoxel): n readings spread over a voxel lie about 1 / sqrt(n) cells
+/// apart, from 4 on half a cell or less, closer than the one cell of height eq. (6) gives each
+/// crossing, so that their rays free nearly the same cells at nearly the same heights. A sparse
+/// sensor's few readings in a voxel are walked each: their rays part by up to a cell, and no
+/// neighbour's ray frees what one of them alone does.
+constexpr std::uint32_t kReadingsForOneRay = 4;
+
+/// The readings of a scan ending in one voxel: their ends while fewer than kReadingsForOneRay
+/// (each walked), and the end nearest the voxel's centre (the one walked for all from then on).
+struct VoxelReadings {
+  std::array<Eigen::Vector3d, kReadingsForOneRay - 1> ends;  ///< the first ones, grid units
+  Eigen::Vector3d nearest;
+  double nearest_distance;  ///< squared, from `nearest` to the voxel's centre
+  std::uint32_t count;
+  bool obstacle;
+};
+
+/// One thread's end voxels in a scan and their readings (FreeSpaceRays::kOnePerEndVoxel). The ray
+/// walked for a voxel of kReadingsForOneRay readings or more is that of the reading ending
+/// nearest its centre, ties to the lowest end in x, then y, then z, so that the choice does not
+/// depend on the readings' order. An open-addressing hash set kept from scan to scan, its slots
+/// stamped with their scan so that none needs clearing.
+class alignas(kCacheLine) EndVoxelRays {
+ public:
+  /// Forgets the previous scan's voxels (their memory is kept).
+  void begin();
+  /// A reading of the scan ending at `end` (grid units).
+  void offer(const Eigen::Vector3d& end, bool obstacle);
+  /// Calls walk(end, obstacle) for the ray of each reading to walk, voxel after voxel in the
+  /// order they were first offered.
+  template <class Walk>
+  void forEachRay(Walk&& walk) const {
+    for (const VoxelReadings& voxel : voxels_) {
+      if (voxel.count >= kReadingsForOneRay) {
+        walk(voxel.nearest, voxel.obstacle);
+        continue;
+      }
+      for (std::uint32_t k = 0; k < voxel.count; ++k) walk(voxel.ends[k], voxel.obstacle);
+    }
+  }
+
+ private:
+  struct Slot {
+    std::int32_t x;
+    std::int32_t y;
+    std::int32_t z;
+    /// The scan's stamp << 1 | obstacle; a slot of another scan is empty.
+    std::uint32_t tag;
+    std::uint32_t index;  ///< in voxels_
+  };
+  /// The index in voxels_ of `voxel`, added to the set (with no reading yet) if it is not there.
+  std::uint32_t find(const EndVoxel& voxel, bool& added);
+  /// Puts `slot` (not in the set) in its place.
+  void place(const Slot& slot);
+  /// Doubles the slots, keeping this scan's.
+  void grow();
+
+  std::vector<Slot> slots_;  ///< a power of two of them, at most half this scan's
+  std::vector<VoxelReadings> voxels_;
+  std::uint32_t stamp_ = 0;  ///< 1 to 2^31 - 1
+  /// The voxel last offered, and its index: a depth image's neighbouring pixels mostly end in
+  /// one.
+  EndVoxel last_{};
+  std::uint32_t last_index_ = 0;
+};
+
 /// Joins the intervals of a list sorted by bottom that come within `join_gap`, in place.
 void joinSorted(std::vector<ScanInterval>& intervals, float join_gap);
 /// Which thread's scratch each reading of a scan goes to, and what decided it: kept from scan
@@ -353,6 +433,12 @@ struct ReadingSplit {
   std::vector<std::uint16_t> sector_of_reading;  ///< the direction of its ray
   std::vector<double> cells_in_sector;           ///< the cell visits of the sector's readings
 };
+/// Whether a scan's free space is walked one ray per end voxel (FreeSpaceRays).
+inline bool walksOneRayPerEndVoxel(const MapConfig& map_config, const InsertionConfig& insertion) {
+  return map_config.rules.mass_counting == MassCounting::kPerScan &&
+         insertion.free_space_rays == FreeSpaceRays::kOnePerEndVoxel &&
+         insertion.model_negative_space;
+}
 /// Splits a scan's readings among `chunks` threads (see scan_update.cpp).
 void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
                            const InsertionConfig& insertion, std::size_t chunks,
@@ -387,6 +473,8 @@ struct ScanUpdate::Impl {
   InsertionResult result;
   /// One per chunk of readings (one per thread).
   std::vector<detail::ScanScratch> scratches;
+  /// One per chunk too: its end voxels and their rays (FreeSpaceRays::kOnePerEndVoxel).
+  std::vector<detail::EndVoxelRays> end_voxels;
   /// With several threads: the scratch of each reading of the scan (splitReadingsBySector).
   detail::ReadingSplit split;
   std::unique_ptr<detail::ThreadPool> pool;

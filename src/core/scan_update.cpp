@@ -9,6 +9,7 @@
 #include <cstring>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "mvog/raster.h"
@@ -28,6 +29,90 @@ void joinSorted(std::vector<ScanInterval>& intervals, float join_gap) {
     }
   }
   intervals.resize(out);
+}
+
+void EndVoxelRays::begin() {
+  voxels_.clear();
+  if (++stamp_ == std::uint32_t{1} << 31) {  // the tag holds 31 bits of stamp: start again
+    for (Slot& slot : slots_) slot.tag = 0;
+    stamp_ = 1;
+  }
+}
+
+namespace {
+
+std::size_t hashOf(std::int32_t x, std::int32_t y, std::int32_t z) {
+  std::uint64_t h = static_cast<std::uint32_t>(x) * 0x9E3779B97F4A7C15ull;
+  h ^= static_cast<std::uint32_t>(y) * 0xC2B2AE3D27D4EB4Full;
+  h ^= static_cast<std::uint32_t>(z) * 0x165667B19E3779F9ull;
+  return static_cast<std::size_t>(h ^ (h >> 32));
+}
+
+/// The voxel `end` (grid units) lies in.
+EndVoxel endVoxelOf(const Eigen::Vector3d& end, bool obstacle) {
+  const CellIndex cell = cellAt(end.x(), end.y());
+  return {cell.x, cell.y, static_cast<std::int32_t>(std::floor(end.z())), obstacle};
+}
+
+}  // namespace
+
+void EndVoxelRays::place(const Slot& slot) {
+  const std::size_t mask = slots_.size() - 1;
+  std::size_t k = hashOf(slot.x, slot.y, slot.z) & mask;
+  while (slots_[k].tag >> 1 == stamp_) k = (k + 1) & mask;
+  slots_[k] = slot;
+}
+
+void EndVoxelRays::grow() {
+  std::vector<Slot> old(std::max<std::size_t>(1024, 2 * slots_.size()), Slot{0, 0, 0, 0, 0});
+  old.swap(slots_);
+  for (const Slot& slot : old) {
+    if (slot.tag >> 1 == stamp_) place(slot);
+  }
+}
+
+std::uint32_t EndVoxelRays::find(const EndVoxel& voxel, bool& added) {
+  const std::uint32_t tag = stamp_ << 1 | static_cast<std::uint32_t>(voxel.obstacle);
+  added = false;
+  if (!voxels_.empty() && voxel == last_) return last_index_;
+  last_ = voxel;
+  if (2 * (voxels_.size() + 1) > slots_.size()) grow();
+  const std::size_t mask = slots_.size() - 1;
+  std::size_t k = hashOf(voxel.x, voxel.y, voxel.z) & mask;
+  for (;; k = (k + 1) & mask) {
+    const Slot& slot = slots_[k];
+    if (slot.tag >> 1 != stamp_) break;
+    if (slot.tag == tag && slot.x == voxel.x && slot.y == voxel.y && slot.z == voxel.z) {
+      return last_index_ = slot.index;
+    }
+  }
+  // A scan holds fewer than 2^32 readings.
+  last_index_ = static_cast<std::uint32_t>(voxels_.size());
+  slots_[k] = {voxel.x, voxel.y, voxel.z, tag, last_index_};
+  added = true;
+  return last_index_;
+}
+
+void EndVoxelRays::offer(const Eigen::Vector3d& end, bool obstacle) {
+  const EndVoxel voxel = endVoxelOf(end, obstacle);
+  const double distance =
+      (end - Eigen::Vector3d(voxel.x + 0.5, voxel.y + 0.5, voxel.z + 0.5)).squaredNorm();
+  bool added = false;
+  const std::uint32_t index = find(voxel, added);
+  if (added) {
+    voxels_.push_back({{end}, end, distance, 1, obstacle});
+    return;
+  }
+  VoxelReadings& readings = voxels_[index];
+  if (readings.count < readings.ends.size()) readings.ends[readings.count] = end;
+  ++readings.count;
+  if (distance < readings.nearest_distance ||
+      (distance == readings.nearest_distance &&
+       std::lexicographical_compare(end.data(), end.data() + 3, readings.nearest.data(),
+                                    readings.nearest.data() + 3))) {
+    readings.nearest = end;
+    readings.nearest_distance = distance;
+  }
 }
 
 /// The most tiles a scan's dense tile index spans (512 KB of pointers); a scan reaching wider
@@ -226,6 +311,14 @@ double freeLengthOf(ReadingKind kind, const MapConfig& map_config, const Inserti
              : std::min(config.max_range, map_config.rules.out_of_range_free_length);
 }
 
+/// Where a reading's ray from `origin` to `end`, `length` long, stops freeing space: its end, or
+/// `free_length` along it.
+Eigen::Vector3d freeEnd(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, double length,
+                        double free_length) {
+  return length > free_length ? Eigen::Vector3d(origin + (end - origin) * (free_length / length))
+                              : end;
+}
+
 /// Checks one reading and counts it in `result`; on acceptance sets the ray's end (truncated to
 /// max_range) and whether it ends in an obstacle.
 bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, ReadingKind kind,
@@ -253,8 +346,7 @@ bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, Re
     ++result.ignored_out_of_range;
     return false;
   }
-  const double free_length = freeLengthOf(kind, map_config, config);
-  ray_end = length > free_length ? Eigen::Vector3d(origin + ray * (free_length / length)) : end;
+  ray_end = freeEnd(origin, end, length, freeLengthOf(kind, map_config, config));
   if (obstacle) {
     ++result.obstacle_readings;
   } else {
@@ -272,11 +364,15 @@ constexpr double kShallowRayMaxHeight = 1 << 20;
 /// height, so every cell it crosses gets this one free volume.
 Volume levelRayVolume(float height) { return makeVolume(height, height); }
 
+/// Eq. (5): a hit's positive volume, one cell high around its height `end_z` (grid units).
+Volume hitVolume(float end_z) { return makeVolume(end_z - 0.5f, end_z + 0.5f); }
+
 /// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`,
-/// each cell's free volume from `free_volume(z_enter, z_exit)`.
+/// each cell's free volume from `free_volume(z_enter, z_exit)`; an obstacle's own positive
+/// volume only if `add_hit` (FreeSpaceRays::kOnePerEndVoxel adds each hit's apart).
 template <class Writer, class FreeVolume>
 void walkReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
-                 Writer& scratch, const FreeVolume& free_volume) {
+                 bool add_hit, Writer& scratch, const FreeVolume& free_volume) {
   const auto end_z = static_cast<float>(end.z());
   walkRayWith(scratch, start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
               [&](double z_enter, double z_exit, bool is_last) {
@@ -284,8 +380,8 @@ void walkReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool 
                   scratch.addFree(free_volume(z_enter, z_exit));
                   return;
                 }
-                const Volume positive = makeVolume(end_z - 0.5f, end_z + 0.5f);  // eq. (5)
-                scratch.addHit(positive);
+                const Volume positive = hitVolume(end_z);
+                if (add_hit) scratch.addHit(positive);
                 if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
                   scratch.addFree(makeVolume(static_cast<float>(z_enter),
                                              z_enter < end.z() ? positive.bottom : positive.top));
@@ -293,24 +389,24 @@ void walkReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool 
               });
 }
 
+/// A hit's positive volume alone (eq. 5), in the cell a walk to `end` (grid units) would end in
+/// (see walkRay), into `scratch` (a copy of the chunk's writer).
+template <class Writer>
+void addHitAt(const Eigen::Vector3d& end, Writer scratch) {
+  scratch.moveTo(cellAt(end.x(), end.y()));
+  scratch.addHit(hitVolume(static_cast<float>(end.z())));
+}
+
 /// The volumes of one reading (see walkReading), into `scratch` (a copy of the chunk's writer,
 /// local to the ray so that the walk keeps it in registers).
 template <class Writer>
 void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
-                bool model_negative_space, Writer scratch) {
+                bool add_hit, Writer scratch) {
   const auto end_z = static_cast<float>(end.z());
-  if (!model_negative_space) {
-    // Only the obstacle's own volume, in the cell the walk would end in (see walkRay): no walk.
-    if (obstacle) {
-      scratch.moveTo(cellAt(end.x(), end.y()));
-      scratch.addHit(makeVolume(end_z - 0.5f, end_z + 0.5f));
-    }
-    return;
-  }
   if (start.z() == end.z()) {
     // A level ray (a 2D laser's): its one free volume made once instead of in each cell.
     const Volume level = levelRayVolume(end_z);
-    walkReading(start, end, obstacle, scratch, [&](double, double) { return level; });
+    walkReading(start, end, obstacle, add_hit, scratch, [&](double, double) { return level; });
     return;
   }
   // Eq. (6) lifts a crossing lower than one cell around its centre. A ray that rises at most half
@@ -320,12 +416,12 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
   const Eigen::Vector3d ray = end - start;
   if (std::fabs(ray.z()) <= 0.5 * std::max(std::fabs(ray.x()), std::fabs(ray.y())) &&
       std::max(std::fabs(start.z()), std::fabs(end.z())) < kShallowRayMaxHeight) {
-    walkReading(start, end, obstacle, scratch, [](double z_enter, double z_exit) {
+    walkReading(start, end, obstacle, add_hit, scratch, [](double z_enter, double z_exit) {
       return makeVolumeAround(0.5f * (static_cast<float>(z_enter) + static_cast<float>(z_exit)));
     });
     return;
   }
-  walkReading(start, end, obstacle, scratch, [](double z_enter, double z_exit) {
+  walkReading(start, end, obstacle, add_hit, scratch, [](double z_enter, double z_exit) {
     return makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit));
   });
 }
@@ -334,26 +430,48 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
 /// this chunk, checked, counted and rasterised into `writer`.
 template <class Writer, class Mine>
 void rasterizeReadings(const Scan& scan, const Mine& mine, const MapConfig& map_config,
-                       const InsertionConfig& insertion, Writer& writer, InsertionResult& result) {
+                       const InsertionConfig& insertion, EndVoxelRays* end_voxels, Writer& writer,
+                       InsertionResult& result) {
   const double s = 1.0 / map_config.resolution;
   const Eigen::Vector3d start = scan.origin * s;
   const std::size_t num_hits = scan.hits.size();
   auto add = [&](const Eigen::Vector3f& end, ReadingKind kind) {
     Eigen::Vector3d ray_end;
     bool obstacle = false;
-    if (acceptReading(scan.origin, end.cast<double>(), kind, map_config, insertion, ray_end,
-                      obstacle, result)) {
-      addReading(start, ray_end * s, obstacle, insertion.model_negative_space, writer);
+    if (!acceptReading(scan.origin, end.cast<double>(), kind, map_config, insertion, ray_end,
+                       obstacle, result)) {
+      return;
     }
+    const Eigen::Vector3d end_cells = ray_end * s;
+    if (!insertion.model_negative_space) {  // only the obstacle's own volume: no walk
+      if (obstacle) addHitAt(end_cells, writer);
+    } else if (end_voxels == nullptr) {
+      addReading(start, end_cells, obstacle, true, writer);
+      ++result.rays_walked;
+    } else {  // each hit's own volume now, the voxel's one ray once all are offered
+      if (obstacle) addHitAt(end_cells, writer);
+      end_voxels->offer(end_cells, obstacle);
+    }
+  };
+  // The rays of the end voxels whose readings ended in an obstacle, or not.
+  auto walk_voxel_rays = [&](bool obstacle) {
+    if (end_voxels == nullptr) return;
+    end_voxels->forEachRay([&](const Eigen::Vector3d& end, bool ends_in_obstacle) {
+      if (ends_in_obstacle != obstacle) return;
+      addReading(start, end, obstacle, false, writer);
+      ++result.rays_walked;
+    });
   };
   const auto began = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < num_hits; ++k) {
     if (mine(k)) add(scan.hits[k], ReadingKind::kObstacle);
   }
+  walk_voxel_rays(true);  // every voxel of an obstacle reading is complete
   const auto hits_done = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < scan.out_of_range.size(); ++k) {
     if (mine(num_hits + k)) add(scan.out_of_range[k], ReadingKind::kOutOfRange);
   }
+  walk_voxel_rays(false);
   result.obstacle_seconds = std::chrono::duration<double>(hits_done - began).count();
   result.out_of_range_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - hits_done).count();
@@ -388,6 +506,7 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
   sector_of.assign(num_readings, 0);
   cells_in.assign(kSectors, 0.0);
   const bool origin_accepted = map_config.withinBounds(scan.origin);
+  const bool by_end_voxel = walksOneRayPerEndVoxel(map_config, insertion);
   for (std::size_t k = 0; k < num_readings; ++k) {
     const bool is_hit = k < num_hits;
     const Eigen::Vector3d end =
@@ -405,12 +524,19 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
     // The walk takes |di| + |dj| steps over the part of the ray it frees: the cells it costs.
     const double walk_cells =
         (std::fabs(ray.x()) + std::fabs(ray.y())) * std::min(1.0, free_length / length) * s + 1.0;
+    Eigen::Vector2d direction = ray.head<2>();
+    if (by_end_voxel) {
+      // The readings of an end voxel go to the one chunk that walks its ray (EndVoxelRays): by
+      // the direction of the voxel's centre.
+      const EndVoxel voxel = endVoxelOf(freeEnd(scan.origin, end, length, free_length) * s, false);
+      direction = Eigen::Vector2d(voxel.x + 0.5, voxel.y + 0.5) - scan.origin.head<2>() * s;
+    }
     // A vertical ray has no direction in xy: it crosses one column, in sector 0.
-    const bool vertical = ray.x() == 0.0 && ray.y() == 0.0;
+    const bool vertical = direction.x() == 0.0 && direction.y() == 0.0;
     const auto sector = static_cast<std::uint16_t>(
-        vertical
-            ? 0.0
-            : std::min<double>(kSectors - 1, pseudoAngle(ray.x(), ray.y()) * (kSectors / 4.0)));
+        vertical ? 0.0
+                 : std::min<double>(kSectors - 1,
+                                    pseudoAngle(direction.x(), direction.y()) * (kSectors / 4.0)));
     sector_of[k] = sector;
     cells_in[sector] += walk_cells;
   }
@@ -470,6 +596,9 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
   impl.result = InsertionResult{};
   const auto num_threads = static_cast<std::size_t>(insertion.insertion_threads);
   impl.scratches.resize(num_threads);
+  const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
+  const bool one_ray_per_end_voxel = detail::walksOneRayPerEndVoxel(map_config, insertion);
+  if (one_ray_per_end_voxel) impl.end_voxels.resize(num_threads);
   const std::size_t num_hits = scan.hits.size();
   const std::size_t num_readings = num_hits + scan.out_of_range.size();
   const double s = 1.0 / map_config.resolution;
@@ -512,19 +641,26 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
       };
       tiles = {tile_of(low), tile_of(high)};
     }
-    const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
+    detail::EndVoxelRays* end_voxels = nullptr;
+    if (one_ray_per_end_voxel) {
+      end_voxels = &impl.end_voxels[chunk];
+      end_voxels->begin();
+    }
     const Volume level_volume = detail::levelRayVolume(static_cast<float>(scan.origin.z() * s));
     scratch.begin(detail::joinGapOf(map_config.rules), count_masses, tiles,
                   level ? &level_volume : nullptr);
     if (count_masses) {
       detail::ScanScratch::Writer<true> writer(scratch);
-      detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
+      detail::rasterizeReadings(scan, mine, map_config, insertion, end_voxels, writer,
+                                results[chunk]);
     } else if (level) {
       detail::ScanScratch::Writer<false, true> writer(scratch);
-      detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
+      detail::rasterizeReadings(scan, mine, map_config, insertion, end_voxels, writer,
+                                results[chunk]);
     } else {
       detail::ScanScratch::Writer<false> writer(scratch);
-      detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
+      detail::rasterizeReadings(scan, mine, map_config, insertion, end_voxels, writer,
+                                results[chunk]);
     }
   };
   if (detail::ThreadPool* pool = impl.threads(num_threads)) {

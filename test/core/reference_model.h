@@ -11,6 +11,7 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -34,6 +35,33 @@ class ReferenceModel {
     std::map<std::pair<std::int32_t, std::int32_t>,
              std::pair<std::vector<Volume>, std::vector<Volume>>>
         seen;  // per cell: the scan's free volumes, its hits' volumes
+    // FreeSpaceRays::kOnePerEndVoxel (masses per scan, free space modelled): each hit adds its
+    // own volume; the readings ending in one voxel (cell, floor of the height, whether an
+    // obstacle) are walked each while fewer than 4, else only the one ending nearest the voxel's
+    // centre (ties: the lowest end in x, then y, then z).
+    const bool one_ray_per_voxel = config_.rules.mass_counting == MassCounting::kPerScan &&
+                                   insertion.free_space_rays == FreeSpaceRays::kOnePerEndVoxel &&
+                                   insertion.model_negative_space;
+    using Voxel = std::tuple<std::int32_t, std::int32_t, std::int32_t, bool>;
+    std::map<Voxel, std::vector<Eigen::Vector3d>> voxel_ends;
+    auto walk = [&](const Eigen::Vector3d& end, bool obstacle, bool with_hit) {
+      const auto end_z = static_cast<float>(end.z());
+      walkRay(
+          start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
+          [&](const CellIndex& c, double z_enter, double z_exit, bool is_last) {
+            auto& [free, hits] = seen[{c.x, c.y}];
+            if (!is_last || !obstacle) {
+              free.push_back(makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
+              return;
+            }
+            const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
+            if (with_hit) hits.push_back(hit);
+            if (std::fabs(z_enter - end.z()) > 1.0) {
+              free.push_back(makeVolume(static_cast<float>(z_enter),
+                                        z_enter < end.z() ? hit.bottom : hit.top));
+            }
+          });
+    };
     auto reading = [&](const Eigen::Vector3f& point, bool is_obstacle) {
       const Eigen::Vector3d ray = point.cast<double>() - scan.origin;
       const double length = ray.norm();
@@ -47,25 +75,42 @@ class ReferenceModel {
           (length > free_length ? Eigen::Vector3d(scan.origin + ray * (free_length / length))
                                 : point.cast<double>()) *
           s;
-      const auto end_z = static_cast<float>(end.z());
-      walkRay(
-          start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
-          [&](const CellIndex& c, double z_enter, double z_exit, bool is_last) {
-            auto& [free, hits] = seen[{c.x, c.y}];
-            if (!is_last || !obstacle) {
-              free.push_back(makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
-              return;
-            }
-            const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
-            hits.push_back(hit);
-            if (std::fabs(z_enter - end.z()) > 1.0) {
-              free.push_back(makeVolume(static_cast<float>(z_enter),
-                                        z_enter < end.z() ? hit.bottom : hit.top));
-            }
-          });
+      if (!one_ray_per_voxel) {
+        walk(end, obstacle, true);
+        return;
+      }
+      if (obstacle) {
+        const Volume hit =
+            makeVolume(static_cast<float>(end.z()) - 0.5f, static_cast<float>(end.z()) + 0.5f);
+        seen[{static_cast<std::int32_t>(std::floor(end.x())),
+              static_cast<std::int32_t>(std::floor(end.y()))}]
+            .second.push_back(hit);
+      }
+      const Eigen::Vector3d floor = end.array().floor();
+      voxel_ends[{static_cast<std::int32_t>(floor.x()), static_cast<std::int32_t>(floor.y()),
+                  static_cast<std::int32_t>(floor.z()), obstacle}]
+          .push_back(end);
     };
     for (const Eigen::Vector3f& hit : scan.hits) reading(hit, true);
     for (const Eigen::Vector3f& end : scan.out_of_range) reading(end, false);
+    for (const auto& [voxel, ends] : voxel_ends) {
+      const bool obstacle = std::get<3>(voxel);
+      if (ends.size() < 4) {
+        for (const Eigen::Vector3d& end : ends) walk(end, obstacle, false);
+        continue;
+      }
+      const Eigen::Vector3d centre =
+          Eigen::Vector3d(std::get<0>(voxel), std::get<1>(voxel), std::get<2>(voxel)) +
+          Eigen::Vector3d::Constant(0.5);
+      const auto nearer = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+        const double da = (a - centre).squaredNorm();
+        const double db = (b - centre).squaredNorm();
+        return da != db
+                   ? da < db
+                   : std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+      };
+      walk(*std::min_element(ends.begin(), ends.end(), nearer), obstacle, false);
+    }
 
     const ModelRules& rules = config_.rules;
     const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
@@ -192,9 +237,9 @@ inline ::testing::AssertionResult sameAsReference(const Map& map, const Referenc
 struct MapBesideReference {
   explicit MapBesideReference(const MapConfig& config) : map(config), reference(config) {}
   /// Inserts `scan` into both; whether they then hold the same.
-  ::testing::AssertionResult insert(const Scan& scan) {
-    map.insertScan(scan);
-    reference.insertScan(scan);
+  ::testing::AssertionResult insert(const Scan& scan, const InsertionConfig& insertion = {}) {
+    map.insertScan(scan, insertion);
+    reference.insertScan(scan, insertion);
     return sameAsReference(map, reference);
   }
 

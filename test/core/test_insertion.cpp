@@ -585,6 +585,20 @@ std::string describe(const ModelRules& rules) {
   return text.str();
 }
 
+/// Insertions walking every reading's ray and one ray per end voxel (FreeSpaceRays).
+std::vector<InsertionConfig> everyRayChoice() {
+  InsertionConfig every_reading;
+  every_reading.free_space_rays = FreeSpaceRays::kEveryReading;
+  InsertionConfig one_per_end_voxel;
+  one_per_end_voxel.free_space_rays = FreeSpaceRays::kOnePerEndVoxel;
+  return {every_reading, one_per_end_voxel};
+}
+
+std::string describe(const InsertionConfig& insertion) {
+  return insertion.free_space_rays == FreeSpaceRays::kEveryReading ? ", every reading's ray"
+                                                                   : ", one ray per end voxel";
+}
+
 /// Scans from a few origins over about 8 x 8 tiles, with hits near each other (so that columns
 /// receive hits and free space of the same scan) and far.
 std::vector<Scan> testScans(unsigned seed) {
@@ -800,10 +814,16 @@ TEST(Insertion, EveryRuleSetEqualsThePlainReference) {
   // The map against test::ReferenceModel, scan after scan: the scratch tiles, the joins, the
   // shortcuts and tiles written in place change nothing the rules decide.
   for (const ModelRules& rules : everyRuleSet()) {
-    SCOPED_TRACE(describe(rules));
-    test::MapBesideReference maps(MapConfig{0.25, 10000.0, rules});
-    for (const Scan& scan : testScans(17)) ASSERT_TRUE(maps.insert(scan));
-    EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
+    for (const InsertionConfig& insertion : everyRayChoice()) {
+      SCOPED_TRACE(describe(rules) + describe(insertion));
+      test::MapBesideReference maps(MapConfig{0.25, 10000.0, rules});
+      std::vector<Scan> scans = testScans(17);
+      // Dense: about 8 readings in a voxel, most voxels walked along one ray.
+      std::mt19937 rng(4);
+      scans.push_back(test::randomScan(rng, {0.1, 0.2, 0.3}, 4000, 1000, 0.8));
+      for (const Scan& scan : scans) ASSERT_TRUE(maps.insert(scan, insertion));
+      EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
+    }
   }
 }
 
@@ -836,17 +856,19 @@ TEST(Insertion, LevelAndShallowRaysEqualThePlainReference) {
   // test::ReferenceModel, which makes every cell's volume from its entry and exit heights (eq. 6).
   std::mt19937 rng(5);
   for (const ModelRules& rules : everyRuleSet()) {
-    SCOPED_TRACE(describe(rules));
-    test::MapBesideReference maps(MapConfig{0.05, 60000.0, rules});
-    for (const double height : {0.3, 0.025, 0.02500001, -0.0, 1.7e-8, -2.4, 52428.0, -52429.0}) {
-      for (const double rise : {0.0, 1e-7, 0.499, 0.501, 1.5}) {
-        const Eigen::Vector2d origin(std::uniform_real_distribution<double>(-1.0, 1.0)(rng),
-                                     std::uniform_real_distribution<double>(-1.0, 1.0)(rng));
-        ASSERT_TRUE(maps.insert(planarLaserScan(rng, origin, height, 121, rise)))
-            << "height " << height << ", rise " << rise;
+    for (const InsertionConfig& insertion : everyRayChoice()) {
+      SCOPED_TRACE(describe(rules) + describe(insertion));
+      test::MapBesideReference maps(MapConfig{0.05, 60000.0, rules});
+      for (const double height : {0.3, 0.025, 0.02500001, -0.0, 1.7e-8, -2.4, 52428.0, -52429.0}) {
+        for (const double rise : {0.0, 1e-7, 0.499, 0.501, 1.5}) {
+          const Eigen::Vector2d origin(std::uniform_real_distribution<double>(-1.0, 1.0)(rng),
+                                       std::uniform_real_distribution<double>(-1.0, 1.0)(rng));
+          ASSERT_TRUE(maps.insert(planarLaserScan(rng, origin, height, 121, rise), insertion))
+              << "height " << height << ", rise " << rise;
+        }
       }
+      EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
     }
-    EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
   }
 }
 
@@ -861,26 +883,28 @@ TEST(Insertion, ColumnsCrossedAtManyHeightsEqualThePlainReference) {
   // counted per scan and per reading).
   std::mt19937 rng(8);
   for (const ModelRules& rules : everyRuleSet()) {
-    SCOPED_TRACE(describe(rules));
-    test::MapBesideReference maps(MapConfig{0.25, 10000.0, rules});
-    for (int k = 0; k < 3; ++k) {
-      Scan scan;
-      scan.origin = {0.1 * k, -0.05 * k, 1.0 + 0.2 * k};
-      std::uniform_real_distribution<double> range(6.0, 8.0);
-      for (int azimuth = 0; azimuth < 5; ++azimuth) {
-        const double angle = 0.02 * azimuth + 0.3 * k;
-        for (int beam = -20; beam <= 20; ++beam) {
-          const double distance = range(rng);
-          const Eigen::Vector3d end =
-              scan.origin +
-              distance * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.15 * beam);
-          (beam % 6 == 0 ? scan.out_of_range : scan.hits).push_back(end.cast<float>());
+    for (const InsertionConfig& insertion : everyRayChoice()) {
+      SCOPED_TRACE(describe(rules) + describe(insertion));
+      test::MapBesideReference maps(MapConfig{0.25, 10000.0, rules});
+      for (int k = 0; k < 3; ++k) {
+        Scan scan;
+        scan.origin = {0.1 * k, -0.05 * k, 1.0 + 0.2 * k};
+        std::uniform_real_distribution<double> range(6.0, 8.0);
+        for (int azimuth = 0; azimuth < 5; ++azimuth) {
+          const double angle = 0.02 * azimuth + 0.3 * k;
+          for (int beam = -20; beam <= 20; ++beam) {
+            const double distance = range(rng);
+            const Eigen::Vector3d end =
+                scan.origin +
+                distance * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.15 * beam);
+            (beam % 6 == 0 ? scan.out_of_range : scan.hits).push_back(end.cast<float>());
+          }
         }
+        std::shuffle(scan.hits.begin(), scan.hits.end(), rng);
+        ASSERT_TRUE(maps.insert(scan, insertion)) << "scan " << k;
       }
-      std::shuffle(scan.hits.begin(), scan.hits.end(), rng);
-      ASSERT_TRUE(maps.insert(scan)) << "scan " << k;
+      EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
     }
-    EXPECT_TRUE(test::mapSatisfiesConstraints(maps.map));
   }
 }
 

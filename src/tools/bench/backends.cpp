@@ -51,6 +51,7 @@ MvogRun runMvog(const InputData& input, const RunOptions& options) {
   mvog::InsertionConfig insertion;
   insertion.max_range = options.max_range;
   insertion.insertion_threads = options.threads;
+  insertion.free_space_rays = options.free_space_rays;
   MvogRun run{mvog::Map(map_config), {}};
   MvogStats& stats = run.stats;
   stats.threads = options.threads;
@@ -292,18 +293,52 @@ std::size_t StateAgreement::points() const {
 
 std::size_t StateAgreement::agreeing() const { return counts[0][0] + counts[1][1] + counts[2][2]; }
 
+namespace {
+
+/// The states two maps give at `at` (`state_of(map, p)` for each), into `into`.
+template <class StateOfFirst, class StateOfSecond>
+void countStates(const std::vector<Eigen::Vector3d>& at, const StateOfFirst& first,
+                 const StateOfSecond& second, StateAgreement& into) {
+  for (const Eigen::Vector3d& p : at) ++into.counts[stateIndex(first(p))][stateIndex(second(p))];
+}
+
+}  // namespace
+
 Agreement compareMaps(const SamplePoints& points, const mvog::Map& map, double occupancy_threshold,
                       const octomap::OcTree& tree) {
   Agreement agreement;
   agreement.sampled_rays = points.sampled_rays;
-  auto compare = [&](const std::vector<Eigen::Vector3d>& at, StateAgreement& into) {
-    for (const Eigen::Vector3d& p : at) {
-      ++into.counts[stateIndex(map.occupancy(p).state(occupancy_threshold))]
-                   [stateIndex(octomapState(tree, p))];
-    }
+  const auto mvog_state = [&](const Eigen::Vector3d& p) {
+    return map.occupancy(p).state(occupancy_threshold);
   };
-  compare(points.endpoints, agreement.endpoints);
-  compare(points.along_rays, agreement.along_rays);
+  const auto octomap_state = [&](const Eigen::Vector3d& p) { return octomapState(tree, p); };
+  countStates(points.endpoints, mvog_state, octomap_state, agreement.endpoints);
+  countStates(points.along_rays, mvog_state, octomap_state, agreement.along_rays);
+  return agreement;
+}
+
+EveryReadingAgreement compareWithEveryReading(const SamplePoints& points, double resolution,
+                                              double occupancy_threshold, const mvog::Map& map,
+                                              const mvog::Map& every_reading) {
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> offset(-kNearEndCells * resolution,
+                                                kNearEndCells * resolution);
+  std::vector<Eigen::Vector3d> near_ends;
+  near_ends.reserve(points.endpoints.size() * kNearEndPoints);
+  for (const Eigen::Vector3d& end : points.endpoints) {
+    for (std::size_t k = 0; k < kNearEndPoints; ++k) {
+      near_ends.push_back(end + Eigen::Vector3d(offset(rng), offset(rng), offset(rng)));
+    }
+  }
+  const auto state = [&](const mvog::Map& of) {
+    return [&of, occupancy_threshold](const Eigen::Vector3d& p) {
+      return of.occupancy(p).state(occupancy_threshold);
+    };
+  };
+  EveryReadingAgreement agreement;
+  countStates(points.endpoints, state(map), state(every_reading), agreement.endpoints);
+  countStates(points.along_rays, state(map), state(every_reading), agreement.along_rays);
+  countStates(near_ends, state(map), state(every_reading), agreement.near_ends);
   return agreement;
 }
 

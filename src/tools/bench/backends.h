@@ -26,6 +26,8 @@ struct RunOptions {
   double occupancy_threshold = mvog::kDefaultOccupancyThreshold;
   /// MVOG only: insert the out-of-range readings too (with rules.out_of_range_free_length).
   bool out_of_range = false;
+  /// MVOG only: which rays are walked for free space (InsertionConfig::free_space_rays).
+  mvog::FreeSpaceRays free_space_rays = mvog::InsertionConfig{}.free_space_rays;
 };
 
 /// Seconds from `start` to now (steady clock): what each backend's insertion took.
@@ -142,5 +144,20 @@ struct Agreement {
 
 Agreement compareMaps(const SamplePoints& points, const mvog::Map& map, double occupancy_threshold,
                       const octomap::OcTree& tree);
+
+/// MVOG's map against a map of the same rays with every reading's ray walked
+/// (mvog::FreeSpaceRays): counts[map][every-reading map], at the sample points and within
+/// kNearEndCells cells of the sampled ends (kNearEndPoints random points around each), where a
+/// surface meets the free space in front of it.
+constexpr double kNearEndCells = 2.0;
+constexpr std::size_t kNearEndPoints = 4;
+struct EveryReadingAgreement {
+  StateAgreement endpoints;
+  StateAgreement along_rays;
+  StateAgreement near_ends;
+};
+EveryReadingAgreement compareWithEveryReading(const SamplePoints& points, double resolution,
+                                              double occupancy_threshold, const mvog::Map& map,
+                                              const mvog::Map& every_reading);
 
 }  // namespace mvog_bench

@@ -1,9 +1,11 @@
 // mvog_bench: MVOG against OctoMap (and Bonxai, when built with it) on the same rays from a ROS
 // bag or an OctoMap scan graph.
 //   mvog_bench --input FILE [--resolution R]... [--max-range M] [--threads N] [--repeat K]
-//              [--backend mvog|octomap|bonxai|walk|both|all] [--json OUT] [--fixed-frame FRAME]
+//              [--backend mvog|octomap|bonxai|walk|every-reading|both|all] [--json OUT]
+//              [--fixed-frame FRAME]
 //              [--model default|paper] [--clip-free-space-at-hits on|off]
 //              [--mass-counting per-scan|per-reading] [--split-free-space-at-obstacles on|off]
+//              [--free-space-rays one-per-end-voxel|every-reading]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
 #include <algorithm>
 #include <chrono>
@@ -35,11 +37,13 @@ struct Arguments {
   mvog::ModelRules rules;
   std::optional<double> occupancy_threshold;
   bool out_of_range = false;  ///< default: the rules' (the paper's for --model paper)
+  mvog::FreeSpaceRays free_space_rays = mvog::InsertionConfig{}.free_space_rays;
   bool run_mvog = false;
   bool run_octomap = false;
   bool run_bonxai = false;
   bool run_walk = false;
   bool bonxai_skipped = false;  ///< --backend all, built without Bonxai
+  bool run_every_reading = false;
   std::string json;
   std::string fixed_frame = "map";
 };
@@ -51,12 +55,13 @@ class UsageError : public std::runtime_error {
 
 constexpr const char* kUsage =
     "usage: mvog_bench --input FILE [--resolution R]... [--max-range M] [--threads N]\n"
-    "                  [--repeat K] [--backend mvog|octomap|bonxai|walk|both|all]\n"
+    "                  [--repeat K] [--backend mvog|octomap|bonxai|walk|every-reading|both|all]\n"
     "                  [--json OUT] [--fixed-frame FRAME]\n"
     "                  [--model default|paper] [--clip-free-space-at-hits on|off]\n"
     "                  [--mass-counting per-scan|per-reading]\n"
     "                  [--split-free-space-at-obstacles on|off] [--occupancy-threshold T]\n"
     "                  [--out-of-range-free-length L|inf]\n"
+    "                  [--free-space-rays one-per-end-voxel|every-reading]\n"
     "  FILE        a ROS bag (LaserScan, PointCloud2 and/or depth Image 16UC1 or 32FC1 with\n"
     "              CameraInfo; poses from /tf and /tf_static)\n"
     "              or an OctoMap ScanGraph (.graph), or synthetic:NAME, a sensor cast into a\n"
@@ -68,8 +73,9 @@ constexpr const char* kUsage =
     "  K           each backend inserts K times, the backends taking turns, and the fastest\n"
     "              run of each is reported (default 1)\n"
     "  --backend   repeatable: mvog, octomap, bonxai (only when built with Bonxai's sources,\n"
-    "              CMake's MVOG_PEERS_DIR), walk (the bare ray walk, MVOG's floor), both (mvog\n"
-    "              and octomap, the default) or all (every one built)\n"
+    "              CMake's MVOG_PEERS_DIR), walk (the bare ray walk, MVOG's floor),\n"
+    "              every-reading (MVOG walking every reading's ray, and MVOG's agreement with\n"
+    "              it), both (mvog and octomap, the default) or all (every one built)\n"
     "  FRAME       the bag's world frame (default map)\n"
     "  T           MVOG is occupied where p > T (default: mvog::kDefaultOccupancyThreshold,\n"
     "              the paper's 0.5 with --model paper)\n"
@@ -77,7 +83,9 @@ constexpr const char* kUsage =
     "              and Bonxai take none: by default every backend disregards them, as the\n"
     "              paper's Table I)\n"
     "  --model     MVOG's rules: the defaults, or the paper's exact model; the options after\n"
-    "              it change one rule each (mvog::ModelRules, README's decisions table)\n";
+    "              it change one rule each (mvog::ModelRules, README's decisions table)\n"
+    "  --free-space-rays  MVOG walks one ray per end voxel (the default) or every reading's\n"
+    "              (mvog::FreeSpaceRays)\n";
 
 double positiveNumber(const std::string& option, const std::string& text) {
   char* end = nullptr;
@@ -124,9 +132,10 @@ Arguments parseArguments(int argc, char** argv) {
       arguments.repeat = wholeNumber(option, value, 100);
     } else if (option == "--backend") {
       if (value != "mvog" && value != "octomap" && value != "bonxai" && value != "walk" &&
-          value != "both" && value != "all") {
-        throw UsageError("--backend must be mvog, octomap, bonxai, walk, both or all, got '" +
-                         value + "'");
+          value != "every-reading" && value != "both" && value != "all") {
+        throw UsageError(
+            "--backend must be mvog, octomap, bonxai, walk, every-reading, both or all, got '" +
+            value + "'");
       }
       if (value == "bonxai" && !mvog_bench::kBonxaiBuilt) {
         throw UsageError(mvog_bench::kBonxaiMissing);
@@ -136,6 +145,7 @@ Arguments parseArguments(int argc, char** argv) {
       arguments.run_bonxai |= (value == "bonxai" || value == "all") && mvog_bench::kBonxaiBuilt;
       arguments.bonxai_skipped |= value == "all" && !mvog_bench::kBonxaiBuilt;
       arguments.run_walk |= value == "walk" || value == "all";
+      arguments.run_every_reading |= value == "every-reading" || value == "all";
     } else if (option == "--occupancy-threshold") {
       const double threshold = positiveNumber(option, value);
       if (threshold >= 1.0) throw UsageError("--occupancy-threshold must be in (0, 1)");
@@ -159,6 +169,13 @@ Arguments parseArguments(int argc, char** argv) {
       }
       arguments.rules.mass_counting =
           value == "per-scan" ? mvog::MassCounting::kPerScan : mvog::MassCounting::kPerReading;
+    } else if (option == "--free-space-rays") {
+      if (value != "one-per-end-voxel" && value != "every-reading") {
+        throw UsageError("--free-space-rays must be one-per-end-voxel or every-reading, got '" +
+                         value + "'");
+      }
+      arguments.free_space_rays = value == "every-reading" ? mvog::FreeSpaceRays::kEveryReading
+                                                           : mvog::FreeSpaceRays::kOnePerEndVoxel;
     } else if (option == "--json") {
       arguments.json = value;
     } else if (option == "--fixed-frame") {
@@ -169,7 +186,8 @@ Arguments parseArguments(int argc, char** argv) {
   }
   if (arguments.input.empty()) throw UsageError("--input is required");
   if (arguments.resolutions.empty()) arguments.resolutions.push_back(0.1);
-  if (!arguments.run_mvog && !arguments.run_octomap && !arguments.run_walk) {
+  if (!arguments.run_mvog && !arguments.run_octomap && !arguments.run_bonxai &&
+      !arguments.run_walk && !arguments.run_every_reading) {
     arguments.run_mvog = arguments.run_octomap = true;
   }
   return arguments;
@@ -199,12 +217,16 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   options.rules = arguments.rules;
   options.occupancy_threshold = occupancyThreshold(arguments);
   options.out_of_range = arguments.out_of_range;
+  options.free_space_rays = arguments.free_space_rays;
   mvog_bench::ResolutionReport report;
   report.resolution = resolution;
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
   std::optional<mvog_bench::MvogRun> mvog;
   std::optional<mvog_bench::OctomapRun> octomap;
   std::optional<mvog_bench::BonxaiRun> bonxai;
+  std::optional<mvog_bench::MvogRun> every_reading;
+  mvog_bench::RunOptions every_reading_options = options;
+  every_reading_options.free_space_rays = mvog::FreeSpaceRays::kEveryReading;
   // The backends take turns, one insertion each a round, so that a slow spell of a shared
   // machine falls on all of them alike rather than on the repeats of one: the ratios of their
   // fastest insertions are then measured over the same time.
@@ -223,6 +245,10 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
                    [](const mvog_bench::BonxaiRun& r) { return r.stats.insert_seconds; });
       }
     }
+    if (arguments.run_every_reading) {
+      keepFaster(every_reading, mvog_bench::runMvog(input, every_reading_options),
+                 [](const mvog_bench::MvogRun& r) { return r.stats.insert_seconds; });
+    }
     if (arguments.run_walk) {
       keepFaster(report.walk, mvog_bench::runWalk(input, options),
                  [](const mvog_bench::WalkStats& r) { return r.insert_seconds; });
@@ -240,6 +266,16 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   if (bonxai) {
     std::fprintf(stderr, "mvog_bench: %.3f m: bonxai inserted in %.3f s\n", resolution,
                  bonxai->stats.insert_seconds);
+  }
+  if (every_reading) {
+    report.every_reading = every_reading->stats;
+    std::fprintf(stderr,
+                 "mvog_bench: %.3f m: mvog walking every reading's ray inserted in %.3f s\n",
+                 resolution, every_reading->stats.insert_seconds);
+    if (mvog) {
+      report.every_reading_agreement = mvog_bench::compareWithEveryReading(
+          points, resolution, options.occupancy_threshold, mvog->map, every_reading->map);
+    }
   }
   if (report.walk) {
     std::fprintf(stderr, "mvog_bench: %.3f m: the bare walk took %.3f s\n", resolution,

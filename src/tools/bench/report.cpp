@@ -108,8 +108,10 @@ JsonObject resultJson(const char* backend, double resolution, std::size_t readin
   return o;
 }
 
-JsonObject mvogJson(double resolution, std::size_t readings, const MvogStats& s) {
-  JsonObject o = resultJson("mvog", resolution, readings, s.insert_seconds);
+/// An MVOG run's figures as `backend` ("mvog", or "mvog_every_reading": every reading's ray).
+JsonObject mvogJson(const char* backend, double resolution, std::size_t readings,
+                    const MvogStats& s) {
+  JsonObject o = resultJson(backend, resolution, readings, s.insert_seconds);
   o.add("memory_bytes", s.memory.bytes_held)
       .add("file_bytes", s.file_bytes)
       .add("threads", s.threads)
@@ -119,6 +121,7 @@ JsonObject mvogJson(double resolution, std::size_t readings, const MvogStats& s)
       .add("positive_volumes", s.memory.positive_volumes)
       .add("negative_volumes", s.memory.negative_volumes)
       .add("tiles", s.memory.tiles)
+      .add("rays_walked", s.insertion.rays_walked)
       .add("obstacle_readings", s.insertion.obstacle_readings)
       .add("truncated_to_max_range", s.insertion.truncated_to_max_range)
       .add("rejected_readings", s.insertion.rejected())
@@ -240,6 +243,13 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                    perSecond(readings, r.mvog->insert_seconds), r.mvog->memory.bytes_held,
                    r.mvog->file_bytes, "-");
     }
+    if (r.every_reading) {
+      std::fprintf(out, "%-8s %7.3f %7d %10zu %10.3f %12.0f %14zu %14zu %14s\n", "mvog-all",
+                   r.resolution, r.every_reading->threads, readings,
+                   r.every_reading->insert_seconds,
+                   perSecond(readings, r.every_reading->insert_seconds),
+                   r.every_reading->memory.bytes_held, r.every_reading->file_bytes, "-");
+    }
     if (r.octomap) {
       std::fprintf(out, "%-8s %7.3f %7d %10zu %10.3f %12.0f %14zu %14zu %14zu\n", "octomap",
                    r.resolution, 1, readings, r.octomap->insert_seconds,
@@ -304,6 +314,29 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                  ratio(r.mvog->insert_seconds, r.walk->insert_seconds), r.walk->cell_visits);
   }
 
+  bool every_reading_header = false;
+  for (const ResolutionReport& r : report.resolutions) {
+    if (!r.mvog || !r.every_reading_agreement) continue;
+    if (!every_reading_header) {
+      std::fprintf(
+          out,
+          "\nMVOG / mvog-all (every reading's ray walked): rays walked, time, memory held; "
+          "agreement (%% of the points in the same state): endpoints, along rays, within "
+          "%.0f cells of the ends\n%7s %12s %12s %12s   %s\n",
+          kNearEndCells, "res (m)", "rays", "time", "memory", "agreement");
+      every_reading_header = true;
+    }
+    const EveryReadingAgreement& a = *r.every_reading_agreement;
+    std::fprintf(out, "%7.3f %11.3fx %11.3fx %11.3fx   %s, %s, %s\n", r.resolution,
+                 ratio(static_cast<double>(r.mvog->insertion.rays_walked),
+                       static_cast<double>(r.every_reading->insertion.rays_walked)),
+                 ratio(r.mvog->insert_seconds, r.every_reading->insert_seconds),
+                 ratio(static_cast<double>(r.mvog->memory.bytes_held),
+                       static_cast<double>(r.every_reading->memory.bytes_held)),
+                 percent(a.endpoints).c_str(), percent(a.along_rays).c_str(),
+                 percent(a.near_ends).c_str());
+  }
+
   bool header = false;
   for (const ResolutionReport& r : report.resolutions) {
     if (!r.mvog || !r.octomap) continue;
@@ -339,11 +372,23 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
 
 void writeJson(const BenchReport& report, const InputData& input, const std::string& path) {
   const std::size_t readings = input.readings();
-  std::vector<JsonObject> results, table_one, comparison, agreement, quality, bonxai_comparison;
+  std::vector<JsonObject> results, table_one, comparison, agreement, quality, bonxai_comparison,
+      every_reading_agreement;
   for (const ResolutionReport& r : report.resolutions) {
-    if (r.mvog) results.push_back(mvogJson(r.resolution, readings, *r.mvog));
+    if (r.mvog) results.push_back(mvogJson("mvog", r.resolution, readings, *r.mvog));
     if (r.octomap) results.push_back(octomapJson(r.resolution, readings, *r.octomap));
     if (r.bonxai) results.push_back(bonxaiJson(r.resolution, readings, *r.bonxai));
+    if (r.every_reading) {
+      results.push_back(mvogJson("mvog_every_reading", r.resolution, readings, *r.every_reading));
+    }
+    if (r.every_reading_agreement) {
+      JsonObject sampled;
+      sampled.add("resolution", r.resolution)
+          .add("endpoints", agreementJson(r.every_reading_agreement->endpoints))
+          .add("along_rays", agreementJson(r.every_reading_agreement->along_rays))
+          .add("near_ends", agreementJson(r.every_reading_agreement->near_ends));
+      every_reading_agreement.push_back(sampled);
+    }
     if (r.walk) {
       JsonObject walk = resultJson("walk", r.resolution, readings, r.walk->insert_seconds);
       walk.add("cell_visits", r.walk->cell_visits);
@@ -427,7 +472,8 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
       .add("quality", quality)
       .add("comparison", comparison)
       .add("agreement", agreement)
-      .add("bonxai_comparison", bonxai_comparison);
+      .add("bonxai_comparison", bonxai_comparison)
+      .add("every_reading_agreement", every_reading_agreement);
 
   const std::string temporary = path + ".tmp." + std::to_string(::getpid());
   {

@@ -23,6 +23,10 @@ struct ResolutionReport {
   std::optional<Quality> octomap_quality;
   std::optional<Quality> bonxai_quality;
   std::optional<Agreement> agreement;  ///< when MVOG and OctoMap ran
+  /// MVOG with every reading's ray walked (--backend every-reading), and MVOG's agreement with
+  /// it when MVOG ran too.
+  std::optional<MvogStats> every_reading;
+  std::optional<EveryReadingAgreement> every_reading_agreement;
 };
 
 struct BenchReport {
