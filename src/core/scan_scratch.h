@@ -357,6 +357,12 @@ struct EndVoxel {
   }
 };
 
+/// The voxel `end` (grid units) lies in.
+inline EndVoxel endVoxelOf(const Eigen::Vector3d& end, bool obstacle) {
+  const CellIndex cell = cellAt(end.x(), end.y());
+  return {cell.x, cell.y, static_cast<std::int32_t>(std::floor(end.z())), obstacle};
+}
+
 /// The fewest readings of a scan ending in one voxel for which one ray is walked
 /// (FreeSpaceRays::kOnePerEndVoxel): n readings spread over a voxel lie about 1 / sqrt(n) cells
 /// apart, from 4 on half a cell or less, closer than the one cell of height eq. (6) gives each
@@ -366,11 +372,15 @@ struct EndVoxel {
 constexpr std::uint32_t kReadingsForOneRay = 4;
 
 /// The readings of a scan ending in one voxel: their ends while fewer than kReadingsForOneRay
-/// (each walked), and the end nearest the voxel's centre (the one walked for all from then on).
+/// (each walked), the end nearest the voxel's centre (the one walked for all from then on), and
+/// in an obstacle's voxel the union of their hits' volumes (eq. 5: each is a cell high and their
+/// heights are less than one apart, so that they overlap).
 struct VoxelReadings {
   std::array<Eigen::Vector3d, kReadingsForOneRay - 1> ends;  ///< the first ones, grid units
   Eigen::Vector3d nearest;
   double nearest_distance;  ///< squared, from `nearest` to the voxel's centre
+  CellIndex cell;
+  Volume hits;  ///< the union of the hits' volumes (masses not counted)
   std::uint32_t count;
   bool obstacle;
 };
@@ -384,8 +394,23 @@ class alignas(kCacheLine) EndVoxelRays {
  public:
   /// Forgets the previous scan's voxels (their memory is kept).
   void begin();
-  /// A reading of the scan ending at `end` (grid units).
-  void offer(const Eigen::Vector3d& end, bool obstacle);
+  /// A reading of the scan ending at `end` (grid units): in an obstacle, whose volume is `*hit`,
+  /// or not (`hit` null). Inline where it ends in the voxel of the reading before.
+  void offer(const Eigen::Vector3d& end, const Volume* hit) {
+    const EndVoxel voxel = endVoxelOf(end, hit != nullptr);
+    if (!voxels_.empty() && voxel == last_) {
+      join(voxels_[last_index_], voxel, end, hit);
+      return;
+    }
+    offerElsewhere(voxel, end, hit);
+  }
+  /// Calls add(cell, volume) with the union of the hits' volumes of each obstacle's voxel.
+  template <class Add>
+  void forEachHit(Add&& add) const {
+    for (const VoxelReadings& voxel : voxels_) {
+      if (voxel.obstacle) add(voxel.cell, voxel.hits);
+    }
+  }
   /// Calls walk(end, obstacle) for the ray of each reading to walk, voxel after voxel in the
   /// order they were first offered.
   template <class Walk>
@@ -408,8 +433,30 @@ class alignas(kCacheLine) EndVoxelRays {
     std::uint32_t tag;
     std::uint32_t index;  ///< in voxels_
   };
-  /// The index in voxels_ of `voxel`, added to the set (with no reading yet) if it is not there.
-  std::uint32_t find(const EndVoxel& voxel, bool& added);
+  /// offer() for a reading ending in another voxel than the reading before.
+  void offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end, const Volume* hit);
+  /// Adds a reading of `voxel` to its readings.
+  static void join(VoxelReadings& readings, const EndVoxel& voxel, const Eigen::Vector3d& end,
+                   const Volume* hit) {
+    if (readings.count < readings.ends.size()) readings.ends[readings.count] = end;
+    ++readings.count;
+    if (hit != nullptr) {
+      readings.hits.bottom = std::min(readings.hits.bottom, hit->bottom);
+      readings.hits.top = std::max(readings.hits.top, hit->top);
+    }
+    const double distance = centreDistance(voxel, end);
+    if (distance < readings.nearest_distance ||
+        (distance == readings.nearest_distance &&
+         std::lexicographical_compare(end.data(), end.data() + 3, readings.nearest.data(),
+                                      readings.nearest.data() + 3))) {
+      readings.nearest = end;
+      readings.nearest_distance = distance;
+    }
+  }
+  /// The squared distance from `end` to the centre of its voxel.
+  static double centreDistance(const EndVoxel& voxel, const Eigen::Vector3d& end) {
+    return (end - Eigen::Vector3d(voxel.x + 0.5, voxel.y + 0.5, voxel.z + 0.5)).squaredNorm();
+  }
   /// Puts `slot` (not in the set) in its place.
   void place(const Slot& slot);
   /// Doubles the slots, keeping this scan's.

@@ -48,12 +48,6 @@ std::size_t hashOf(std::int32_t x, std::int32_t y, std::int32_t z) {
   return static_cast<std::size_t>(h ^ (h >> 32));
 }
 
-/// The voxel `end` (grid units) lies in.
-EndVoxel endVoxelOf(const Eigen::Vector3d& end, bool obstacle) {
-  const CellIndex cell = cellAt(end.x(), end.y());
-  return {cell.x, cell.y, static_cast<std::int32_t>(std::floor(end.z())), obstacle};
-}
-
 }  // namespace
 
 void EndVoxelRays::place(const Slot& slot) {
@@ -71,11 +65,10 @@ void EndVoxelRays::grow() {
   }
 }
 
-std::uint32_t EndVoxelRays::find(const EndVoxel& voxel, bool& added) {
-  const std::uint32_t tag = stamp_ << 1 | static_cast<std::uint32_t>(voxel.obstacle);
-  added = false;
-  if (!voxels_.empty() && voxel == last_) return last_index_;
+void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end,
+                                  const Volume* hit) {
   last_ = voxel;
+  const std::uint32_t tag = stamp_ << 1 | static_cast<std::uint32_t>(voxel.obstacle);
   if (2 * (voxels_.size() + 1) > slots_.size()) grow();
   const std::size_t mask = slots_.size() - 1;
   std::size_t k = hashOf(voxel.x, voxel.y, voxel.z) & mask;
@@ -83,36 +76,21 @@ std::uint32_t EndVoxelRays::find(const EndVoxel& voxel, bool& added) {
     const Slot& slot = slots_[k];
     if (slot.tag >> 1 != stamp_) break;
     if (slot.tag == tag && slot.x == voxel.x && slot.y == voxel.y && slot.z == voxel.z) {
-      return last_index_ = slot.index;
+      last_index_ = slot.index;
+      join(voxels_[last_index_], voxel, end, hit);
+      return;
     }
   }
   // A scan holds fewer than 2^32 readings.
   last_index_ = static_cast<std::uint32_t>(voxels_.size());
   slots_[k] = {voxel.x, voxel.y, voxel.z, tag, last_index_};
-  added = true;
-  return last_index_;
-}
-
-void EndVoxelRays::offer(const Eigen::Vector3d& end, bool obstacle) {
-  const EndVoxel voxel = endVoxelOf(end, obstacle);
-  const double distance =
-      (end - Eigen::Vector3d(voxel.x + 0.5, voxel.y + 0.5, voxel.z + 0.5)).squaredNorm();
-  bool added = false;
-  const std::uint32_t index = find(voxel, added);
-  if (added) {
-    voxels_.push_back({{end}, end, distance, 1, obstacle});
-    return;
-  }
-  VoxelReadings& readings = voxels_[index];
-  if (readings.count < readings.ends.size()) readings.ends[readings.count] = end;
-  ++readings.count;
-  if (distance < readings.nearest_distance ||
-      (distance == readings.nearest_distance &&
-       std::lexicographical_compare(end.data(), end.data() + 3, readings.nearest.data(),
-                                    readings.nearest.data() + 3))) {
-    readings.nearest = end;
-    readings.nearest_distance = distance;
-  }
+  voxels_.push_back({{end},
+                     end,
+                     centreDistance(voxel, end),
+                     {voxel.x, voxel.y},
+                     hit != nullptr ? *hit : Volume{},
+                     1,
+                     voxel.obstacle});
 }
 
 /// The most tiles a scan's dense tile index spans (512 KB of pointers); a scan reaching wider
@@ -448,9 +426,9 @@ void rasterizeReadings(const Scan& scan, const Mine& mine, const MapConfig& map_
     } else if (end_voxels == nullptr) {
       addReading(start, end_cells, obstacle, true, writer);
       ++result.rays_walked;
-    } else {  // each hit's own volume now, the voxel's one ray once all are offered
-      if (obstacle) addHitAt(end_cells, writer);
-      end_voxels->offer(end_cells, obstacle);
+    } else {  // the voxel's hits and its rays once all its readings are offered
+      const Volume hit = hitVolume(static_cast<float>(end_cells.z()));
+      end_voxels->offer(end_cells, obstacle ? &hit : nullptr);
     }
   };
   // The rays of the end voxels whose readings ended in an obstacle, or not.
@@ -466,7 +444,14 @@ void rasterizeReadings(const Scan& scan, const Mine& mine, const MapConfig& map_
   for (std::size_t k = 0; k < num_hits; ++k) {
     if (mine(k)) add(scan.hits[k], ReadingKind::kObstacle);
   }
-  walk_voxel_rays(true);  // every voxel of an obstacle reading is complete
+  if (end_voxels != nullptr) {  // every voxel of an obstacle reading is complete
+    end_voxels->forEachHit([&](const CellIndex& cell, const Volume& hits) {
+      auto hit_writer = writer;
+      hit_writer.moveTo(cell);
+      hit_writer.addHit(hits);
+    });
+  }
+  walk_voxel_rays(true);
   const auto hits_done = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < scan.out_of_range.size(); ++k) {
     if (mine(num_hits + k)) add(scan.out_of_range[k], ReadingKind::kOutOfRange);
