@@ -21,6 +21,7 @@ struct InsertionStatistics {
   std::uint64_t messages_inserted = 0;
   std::uint64_t messages_dropped_queue = 0;  // the oldest waiting, when the queue was full
   std::uint64_t readings_inserted = 0;
+  std::uint64_t rays_walked = 0;        // for free space: mvog::InsertionResult::rays_walked
   std::uint64_t readings_rejected = 0;  // by the core: mvog::InsertionResult::rejected()
   double insertion_seconds = 0.0;
   std::uint64_t out_of_range_readings = 0;
@@ -73,6 +74,7 @@ class InsertionWorker {
   std::atomic<std::uint64_t> messages_inserted_{0};
   std::atomic<std::uint64_t> messages_dropped_queue_{0};
   std::atomic<std::uint64_t> readings_inserted_{0};
+  std::atomic<std::uint64_t> rays_walked_{0};
   std::atomic<std::uint64_t> readings_rejected_{0};
   std::atomic<std::uint64_t> insertion_nanoseconds_{0};
   std::atomic<std::uint64_t> out_of_range_readings_{0};

@@ -33,13 +33,19 @@ struct SensorInputsConfig {
 };
 
 /// The insertion worker (InsertionWorker): the core's insertion parameters (~min_range,
-/// ~max_range, ~insert_out_of_range, ~model_negative_space, ~insertion_threads), and its queue.
+/// ~max_range, ~insert_out_of_range, ~model_negative_space, ~insertion_threads,
+/// ~free_space_rays), and its queue.
 /// The model's rules are the map's (MapperConfig::map: ~model, ~clip_free_space_at_hits, ...).
 struct InsertionWorkerConfig : mvog::InsertionConfig {
   int insertion_queue_size = 3;  // converted messages waiting to be inserted
 
   void validate() const;
 };
+
+/// ~free_space_rays: `one_per_end_voxel` (FreeSpaceRays::kOnePerEndVoxel, the default) or
+/// `every_reading` (FreeSpaceRays::kEveryReading). Throws mvog::ConfigError naming the parameter
+/// for any other name.
+mvog::FreeSpaceRays freeSpaceRaysFromName(const std::string& name);
 
 /// Decay (Sec. III-E): masses times decay_factor every decay_period seconds.
 struct DecayConfig {

@@ -56,6 +56,7 @@ void InsertionWorker::run() {
                                        std::chrono::steady_clock::now() - start)
                                        .count());
     readings_inserted_ += result.inserted();
+    rays_walked_ += result.rays_walked;
     readings_rejected_ += result.rejected();
     out_of_range_readings_ += result.out_of_range_readings;
     obstacle_nanoseconds_ += static_cast<std::uint64_t>(1e9 * result.obstacle_seconds);
@@ -96,6 +97,7 @@ InsertionStatistics InsertionWorker::statistics() const {
   statistics.messages_inserted = messages_inserted_.load();
   statistics.messages_dropped_queue = messages_dropped_queue_.load();
   statistics.readings_inserted = readings_inserted_.load();
+  statistics.rays_walked = rays_walked_.load();
   statistics.readings_rejected = readings_rejected_.load();
   statistics.insertion_seconds = 1e-9 * static_cast<double>(insertion_nanoseconds_.load());
   statistics.out_of_range_readings = out_of_range_readings_.load();
@@ -111,9 +113,9 @@ std::optional<Eigen::Vector3d> InsertionWorker::latestOrigin() const {
 
 void InsertionWorker::resetStatistics() {
   for (std::atomic<std::uint64_t>* counter :
-       {&messages_inserted_, &messages_dropped_queue_, &readings_inserted_, &readings_rejected_,
-        &insertion_nanoseconds_, &out_of_range_readings_, &obstacle_nanoseconds_,
-        &out_of_range_nanoseconds_}) {
+       {&messages_inserted_, &messages_dropped_queue_, &readings_inserted_, &rays_walked_,
+        &readings_rejected_, &insertion_nanoseconds_, &out_of_range_readings_,
+        &obstacle_nanoseconds_, &out_of_range_nanoseconds_}) {
     counter->store(0);
   }
 }

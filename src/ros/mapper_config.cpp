@@ -177,6 +177,13 @@ void InsertionWorkerConfig::validate() const {
           "must be in [1, 1000]");
 }
 
+mvog::FreeSpaceRays freeSpaceRaysFromName(const std::string& name) {
+  if (name == "every_reading") return mvog::FreeSpaceRays::kEveryReading;
+  require(name == "one_per_end_voxel", "free_space_rays",
+          "must be 'one_per_end_voxel' or 'every_reading', not '" + name + "'");
+  return mvog::FreeSpaceRays::kOnePerEndVoxel;
+}
+
 void DecayConfig::validate() const {
   require(std::isfinite(decay_factor) && decay_factor > 0.0 && decay_factor <= 1.0, "decay_factor",
           "must be in (0, 1]");
@@ -266,6 +273,9 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   read(nh, "insert_out_of_range", insertion.insert_out_of_range);
   read(nh, "model_negative_space", insertion.model_negative_space);
   read(nh, "insertion_threads", insertion.insertion_threads);
+  std::string free_space_rays = "one_per_end_voxel";
+  read(nh, "free_space_rays", free_space_rays);
+  insertion.free_space_rays = freeSpaceRaysFromName(free_space_rays);
   read(nh, "insertion_queue_size", insertion.insertion_queue_size);
 
   read(nh, "decay_factor", config.decay.decay_factor);

@@ -53,6 +53,9 @@ TEST_F(InsertionWorkerTest, InsertsWhatIsQueuedAndCountsWhatItDid) {
   EXPECT_EQ(statistics.messages_dropped_queue, 0u);
   EXPECT_EQ(statistics.readings_inserted, 5u * 101);  // hits and the out-of-range reading
   EXPECT_EQ(statistics.readings_rejected, 5u * 2);    // the NaN hits
+  // For free space: at most one ray per reading (one per end voxel by default).
+  EXPECT_GT(statistics.rays_walked, 0u);
+  EXPECT_LE(statistics.rays_walked, statistics.readings_inserted);
   EXPECT_GE(statistics.insertion_seconds, 0.0);
   EXPECT_EQ(shared_map.map.occupancy({5.05, 0.05, 1.0}).state(0.5),
             mvog::OccupancyState::kOccupied);
@@ -61,6 +64,7 @@ TEST_F(InsertionWorkerTest, InsertsWhatIsQueuedAndCountsWhatItDid) {
   const InsertionStatistics reset = worker.statistics();
   EXPECT_EQ(reset.messages_inserted, 0u);
   EXPECT_EQ(reset.readings_inserted, 0u);
+  EXPECT_EQ(reset.rays_walked, 0u);
   EXPECT_EQ(reset.readings_rejected, 0u);
   EXPECT_EQ(reset.insertion_seconds, 0.0);
 }
@@ -111,6 +115,7 @@ TEST_F(InsertionWorkerTest, AScanPreparedOutsideTheLockBuildsTheMapOfInsertScan)
       EXPECT_EQ(worker.statistics().readings_inserted, expected.inserted());
       EXPECT_EQ(worker.statistics().readings_rejected, expected.rejected());
       EXPECT_EQ(worker.statistics().out_of_range_readings, expected.out_of_range_readings);
+      EXPECT_EQ(worker.statistics().rays_walked, expected.rays_walked);
     }
   }
 }

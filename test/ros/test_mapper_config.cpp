@@ -295,6 +295,32 @@ TEST(MapperConfig, RefusesForgettingWithoutDecayAndBadWindows) {
   EXPECT_EQ(refusal(config), "");
 }
 
+TEST(MapperConfig, FreeSpaceRaysDefaultsToOnePerEndVoxelAndReadsBothNames) {
+  EXPECT_EQ(validConfig().insertion.free_space_rays, mvog::FreeSpaceRays::kOnePerEndVoxel);
+  EXPECT_EQ(freeSpaceRaysFromName("one_per_end_voxel"), mvog::FreeSpaceRays::kOnePerEndVoxel);
+  EXPECT_EQ(freeSpaceRaysFromName("every_reading"), mvog::FreeSpaceRays::kEveryReading);
+  MapperConfig config = validConfig();
+  config.insertion.free_space_rays = mvog::FreeSpaceRays::kEveryReading;
+  EXPECT_EQ(refusal(config), "");
+}
+
+TEST(MapperConfig, RefusesAnUnknownFreeSpaceRaysNamingIt) {
+  // mvog_bench's spelling, another case, empty: only the two names are read.
+  for (const char* name : {"every-reading", "Every_Reading", "one_per_voxel", ""}) {
+    std::string message;
+    try {
+      freeSpaceRaysFromName(name);
+    } catch (const mvog::ConfigError& e) {
+      message = e.what();
+    }
+    EXPECT_EQ(message.rfind("~free_space_rays:", 0), 0u)
+        << "'" << name << "': got '" << message << "'";
+  }
+  expectRefused({"free_space_rays", "not a FreeSpaceRays", [](MapperConfig& c) {
+                   c.insertion.free_space_rays = static_cast<mvog::FreeSpaceRays>(7);
+                 }});
+}
+
 TEST(MapperConfig, AnEmptyAutosaveFileIsFineWhileAutosaveIsOff) {
   MapperConfig config = validConfig();
   config.map_files.autosave_file.clear();

@@ -571,6 +571,8 @@ TEST_F(Mapper, CountsReadingsAndDroppedMessages) {
                                               kClouds * (kPointsPerCloud - kNaNPointsPerCloud));
   EXPECT_EQ(statistics.readings_rejected,
             kScans * kSkippedBeamsPerScan + kClouds * kNaNPointsPerCloud);
+  EXPECT_GT(statistics.rays_walked, 0u);
+  EXPECT_LE(statistics.rays_walked, statistics.readings_inserted);
   EXPECT_GT(statistics.positive_volumes, 0u);
   EXPECT_GT(statistics.negative_volumes, 0u);
   EXPECT_GT(statistics.cells_with_volumes, 0u);
@@ -601,6 +603,7 @@ TEST_F(Mapper, ReportsItsStatisticsOnDiagnostics) {
   EXPECT_TRUE(diagnostics.waitForMessage([&](const diagnostic_msgs::DiagnosticArray& array) {
     return diagnosticValue(array, status, "messages_inserted") == inserted &&
            diagnosticValue(array, status, "messages_dropped_queue") == "0" &&
+           !diagnosticValue(array, status, "rays_walked").empty() &&
            diagnosticValue(array, status, "frame_id") == "map";
   })) << "no status '"
       << status << "' with " << inserted << " messages inserted";
@@ -1055,6 +1058,7 @@ TEST(RefusedStart, TheNodeRefusesInvalidParametersNamingThem) {
       {"refused_frame", "_frame_id:=/map", "~frame_id"},
       {"refused_decay", "_decay_factor:=1.5", "~decay_factor"},
       {"refused_ranges", "_min_range:=5.0 _max_range:=2.0", "~min_range"},
+      {"refused_free_space_rays", "_free_space_rays:=every-reading", "~free_space_rays"},
       {"refused_map_file", "_map_file:=missing.mvog", "~map_file"},
       {"refused_map_directory", "_map_directory:=/proc/mvog_cannot_be_here", "~map_directory"},
   };

@@ -62,6 +62,7 @@ void StatisticsPublication::diagnose(diagnostic_updater::DiagnosticStatusWrapper
   status.add("bytes_held", s.bytes_held);
   status.add("table_one_bytes", s.table_one_bytes);
   status.add("readings_inserted", s.readings_inserted);
+  status.add("rays_walked", s.rays_walked);
   status.add("readings_rejected", s.readings_rejected);
   status.add("readings_per_second", s.readings_per_second);
   status.add("insertion_seconds", s.insertion_seconds);
@@ -91,6 +92,7 @@ mvog::MapStatistics StatisticsPublication::statistics() {
   const InsertionStatistics insertion = insertion_.statistics();
   const ros::WallTime now = ros::WallTime::now();
   statistics.readings_inserted = insertion.readings_inserted;
+  statistics.rays_walked = insertion.rays_walked;
   const double elapsed = (now - last_statistics_time_).toSec();
   if (elapsed > 0.0 && statistics.readings_inserted >= readings_at_last_statistics_) {
     statistics.readings_per_second =
