@@ -59,8 +59,8 @@ class InsertionWorker {
 
   void run();
   /// The worker's one call into the core: `scan` into the map, prepared outside the map's lock
-  /// and applied under its write lock.
-  mvog::InsertionResult insert(const mvog::Scan& scan);
+  /// and applied under its write lock; with ~backlog_insertion_threads if `backlog`.
+  mvog::InsertionResult insert(const mvog::Scan& scan, bool backlog);
 
   const InsertionWorkerConfig config_;
   SharedMap& map_;

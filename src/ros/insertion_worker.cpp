@@ -1,5 +1,6 @@
 #include "mvog_ros/insertion_worker.h"
 
+#include <algorithm>
 #include <chrono>
 #include <mutex>
 #include <shared_mutex>
@@ -42,15 +43,17 @@ void InsertionWorker::stop() {
 void InsertionWorker::run() {
   for (;;) {
     QueuedScan queued;
+    bool backlog = false;  // another message waits behind this one
     {
       std::unique_lock<std::mutex> lock(queue_mutex_);
       queue_changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
       if (queue_.empty()) return;  // stopping, and what was queued is in the map
       queued = std::move(queue_.front());
       queue_.pop_front();
+      backlog = !queue_.empty();
     }
     const auto start = std::chrono::steady_clock::now();
-    const mvog::InsertionResult result = insert(queued.scan);
+    const mvog::InsertionResult result = insert(queued.scan, backlog);
     insertion_nanoseconds_ +=
         static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                        std::chrono::steady_clock::now() - start)
@@ -74,20 +77,25 @@ void InsertionWorker::run() {
   }
 }
 
-mvog::InsertionResult InsertionWorker::insert(const mvog::Scan& scan) {
+mvog::InsertionResult InsertionWorker::insert(const mvog::Scan& scan, bool backlog) {
   // The scan goes in whole (Fig. 2: the constraints once per scan). Its rasterisation reads
   // nothing of the map but its configuration: it runs outside the lock, which queries and
   // publications then wait for only while the scan's columns are merged.
+  mvog::InsertionConfig insertion = config_;
+  if (backlog) {
+    insertion.insertion_threads =
+        std::max(insertion.insertion_threads, config_.backlog_insertion_threads);
+  }
   mvog::MapConfig map_config;
   {
     std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
     map_config = map_.map.config();
   }
-  update_.prepare(scan, map_config, config_);
+  update_.prepare(scan, map_config, insertion);
   std::unique_lock<WriterPreferringMutex> lock(map_.mutex);
   if (!update_.preparedFor(map_.map.config())) {
     // ~load_map put a map of another configuration in place meanwhile.
-    update_.prepare(scan, map_.map.config(), config_);
+    update_.prepare(scan, map_.map.config(), insertion);
   }
   return map_.map.apply(update_);
 }

@@ -175,6 +175,8 @@ void InsertionWorkerConfig::validate() const {
   validateCoreConfig<mvog::InsertionConfig>(*this);
   require(insertion_queue_size >= 1 && insertion_queue_size <= 1000, "insertion_queue_size",
           "must be in [1, 1000]");
+  require(backlog_insertion_threads >= 1 && backlog_insertion_threads <= 256,
+          "backlog_insertion_threads", "must be in [1, 256]");
 }
 
 mvog::FreeSpaceRays freeSpaceRaysFromName(const std::string& name) {
@@ -277,6 +279,7 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   read(nh, "free_space_rays", free_space_rays);
   insertion.free_space_rays = freeSpaceRaysFromName(free_space_rays);
   read(nh, "insertion_queue_size", insertion.insertion_queue_size);
+  read(nh, "backlog_insertion_threads", insertion.backlog_insertion_threads);
 
   read(nh, "decay_factor", config.decay.decay_factor);
   read(nh, "decay_period", config.decay.decay_period);

@@ -120,6 +120,27 @@ TEST_F(InsertionWorkerTest, AScanPreparedOutsideTheLockBuildsTheMapOfInsertScan)
   }
 }
 
+TEST_F(InsertionWorkerTest, ABacklogInsertedOnMoreThreadsBuildsTheSameMap) {
+  // Scans queued faster than the worker inserts them go in on ~backlog_insertion_threads while
+  // another waits: the map of inserting them one by one on one thread, bit for bit.
+  std::vector<mvog::Scan> scans;
+  for (std::uint32_t k = 0; k < 12; ++k) {
+    scans.push_back(scanOf(20000, 0, {0.1 * k, -0.2, 1.0 + 0.05 * k}, k));
+  }
+  mvog::Map one_by_one(mapConfig());
+  for (const mvog::Scan& scan : scans) one_by_one.insertScan(scan);
+
+  SharedMap shared_map{mvog::Map(mapConfig())};
+  InsertionWorkerConfig config;
+  config.insertion_queue_size = 100;
+  config.backlog_insertion_threads = 4;
+  InsertionWorker worker(config, shared_map);
+  for (const mvog::Scan& scan : scans) worker.enqueue(mvog::Scan(scan), "test");
+  worker.stop();
+  EXPECT_EQ(worker.statistics().messages_inserted, scans.size());
+  EXPECT_EQ(mvog::serializeMap(shared_map.map), mvog::serializeMap(one_by_one));
+}
+
 TEST_F(InsertionWorkerTest, ScansGoIntoMapsReplacedWhileTheyArePrepared) {
   // ~load_map may put a map of another resolution or other rules in place between a scan's
   // preparation (outside the lock) and its application: the worker prepares it again for the
