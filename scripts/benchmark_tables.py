@@ -52,6 +52,30 @@ def bonxai_columns(run, resolution):
     }
 
 
+def state_agreement(matrix):
+    """The % of the points in the same state of an agreement matrix (mvog_bench's JSON)."""
+    same = sum(matrix[state][state] for state in matrix)
+    total = sum(sum(row.values()) for row in matrix.values())
+    return percent(100.0 * same / total) if total else "-"
+
+
+def every_reading_row(name, resolution, run):
+    """MVOG's default insertion (one ray per end voxel) against every reading's walk, when the run
+    has both (--backend every-reading): rays, time and memory ratios, and the agreement."""
+    results = {b: by_resolution(run["results"], b).get(resolution)
+               for b in ("mvog", "mvog_every_reading")}
+    agreement = by_resolution(run.get("every_reading_agreement", [])).get(resolution)
+    mv, every = results["mvog"], results["mvog_every_reading"]
+    if not (mv and every and agreement):
+        return None
+    return [name, f"{resolution:g}", f"{mv['readings']:,}", f"{mv['rays_walked']:,}",
+            f"{every['insert_seconds']:.3f}", f"{mv['insert_seconds']:.3f}",
+            f"{every['insert_seconds'] / mv['insert_seconds']:.2f}x",
+            f"{mv['memory_bytes'] / every['memory_bytes']:.3f}x",
+            state_agreement(agreement["endpoints"]), state_agreement(agreement["along_rays"]),
+            state_agreement(agreement["near_ends"])]
+
+
 def file_name(path, prefix):
     return os.path.basename(path)[len(prefix):-len(".json")]
 
@@ -120,7 +144,7 @@ def main(out):
     if not runs:
         sys.exit(f"benchmark_tables.py: no all_*.json in {out}")
 
-    quality, speed, memory, threads = [], [], [], []
+    quality, speed, memory, threads, every_reading = [], [], [], [], []
     # Bonxai's columns when some run has them (mvog_bench built with MVOG_PEERS_DIR).
     with_bonxai = any(run.get("bonxai_comparison") for run in runs.values())
     for name, run in runs.items():
@@ -148,6 +172,7 @@ def main(out):
                 f"{comparison[resolution]['readings_per_second_ratio']:.1f}x",
                 f"{walk['mvog_time_ratio']:.2f}x",
             ] + ([bonxai[c] for c in BONXAI_SPEED] if with_bonxai else []))
+            every_reading.append(every_reading_row(name, resolution, run))
             memory.append([
                 name, f"{resolution:g}", megabytes(mv["memory_bytes"]),
                 megabytes(oc["memory_bytes"]), f"{comparison[resolution]['memory_ratio']:.3f}x",
@@ -180,6 +205,17 @@ def main(out):
     print(table(["file", "res (m)", "readings", "MVOG (s)", "OctoMap (s)", "walk (s)",
                  "MVOG M readings/s", "MVOG / OctoMap speed", "MVOG / walk time"] +
                 (BONXAI_SPEED if with_bonxai else []), speed))
+    # The synthetic sensors too (scenes built in code: sensors none of the recordings has).
+    for path in sorted(glob.glob(f"{out}/synthetic_*.json")):
+        run = load(path)
+        for resolution in sorted(by_resolution(run["quality"], "mvog"), reverse=True):
+            every_reading.append(every_reading_row(file_name(path, "synthetic_"), resolution, run))
+    every_reading = [r for r in every_reading if r]
+    if every_reading:
+        print("\n### One ray per end voxel against every reading's ray (MVOG, one thread)\n")
+        print(table(["file", "res (m)", "readings", "rays walked", "every reading (s)",
+                     "one per end voxel (s)", "speed-up", "memory", "same state: ends",
+                     "along rays", "within 2 cells of the ends"], every_reading))
     print("\n### Memory (MB)\n")
     print(table(["file", "res (m)", "MVOG held", "OctoMap held (pruned)", "MVOG / OctoMap",
                  "Table I: MVOG", "Table I: OctoMap", "MVOG file", "OctoMap .ot file"] +

@@ -6,8 +6,10 @@ PointCloud2 of --points points (float32 x, y, z in the sensor frame, 1 cm noise)
 --rate Hz for --duration s, with its pose on /tf (map -> load_sensor, stamped like the cloud) at
 twice that rate. With --depth WIDTHxHEIGHT the sensor is a depth camera instead (Kinect-like
 intrinsics, 1 cm noise): every message is a depth image of --depth-encoding with its camera info,
-in the optical frame load_sensor_optical (a static transform from load_sensor). Meanwhile a client asks ~get_occupancy for --query-points random points of the
-room at --query-rate Hz. The script starts its own mvog_node (the server's defaults but for
+in the optical frame load_sensor_optical (a static transform from load_sensor). With --lidar
+BEAMSxCOLUMNS it is a rotating lidar: every message is a whole turn, BEAMS x COLUMNS points.
+Meanwhile a client asks ~get_occupancy for --query-points random points of the room at
+--query-rate Hz. The script starts its own mvog_node (the server's defaults but for
 --resolution, --max-range and --insertion-threads) and reports:
 
 - readings inserted per second (the server's own counters over the run),
@@ -50,6 +52,8 @@ def arguments():
     parser.add_argument("--points", type=int, default=300000, help="points per cloud")
     parser.add_argument("--depth", metavar="WIDTHxHEIGHT",
                         help="publish depth images of this size instead of clouds")
+    parser.add_argument("--lidar", metavar="BEAMSxCOLUMNS",
+                        help="publish the clouds of a rotating lidar instead, a turn a cloud")
     parser.add_argument("--depth-encoding", choices=("16UC1", "32FC1"), default="16UC1")
     parser.add_argument("--depth-stride", type=int, default=1, help="the server's ~depth_stride")
     parser.add_argument("--rate", type=float, default=30.0, help="messages per second")
@@ -106,6 +110,20 @@ class RaySet:
         the bytes of float32 x, y, z."""
         distance = room_distances(self.directions, position, yaw)
         return (self.directions * (distance + self.noise)[:, None]).tobytes()
+
+
+class RotatingLidar(RaySet):
+    """A rotating lidar of `beams` beams from +2 to -24.8 degrees of elevation (a Velodyne
+    HDL-64E's) and `columns` firings a turn, a whole turn a cloud, range noise (1 cm) per ray."""
+
+    def __init__(self, beams, columns, seed):
+        random = np.random.default_rng(seed)
+        elevation = np.repeat(np.radians(np.linspace(2.0, -24.8, beams)), columns)
+        azimuth = np.tile(np.linspace(-np.pi, np.pi, columns, endpoint=False), beams)
+        self.directions = np.stack([np.cos(elevation) * np.cos(azimuth),
+                                    np.cos(elevation) * np.sin(azimuth),
+                                    np.sin(elevation)], axis=1).astype(np.float32)
+        self.noise = random.normal(0.0, 0.01, beams * columns).astype(np.float32)
 
 
 class DepthCamera:
@@ -221,6 +239,12 @@ def main():
             static_broadcaster = tf2_ros.StaticTransformBroadcaster()
             static_broadcaster.sendTransform(optical_frame_transform())
             what = "%dx%d %s depth images" % (width, height, args.depth_encoding)
+        elif args.lidar:
+            beams, columns = (int(v) for v in args.lidar.split("x"))
+            ray_sets = [RotatingLidar(beams, columns, seed) for seed in range(4)]
+            template = rel.cloud([], width=beams * columns, frame=SENSOR_FRAME,
+                                 data=bytes(12 * beams * columns))
+            what = "%d-beam lidar turns of %d columns" % (beams, columns)
         else:
             ray_sets = [RaySet(args.points, seed) for seed in range(4)]
             template = rel.cloud([], width=args.points, frame=SENSOR_FRAME,
@@ -299,7 +323,7 @@ def main():
     readings = final.readings_inserted - before.readings_inserted
     insertion_seconds = final.insertion_seconds - before.insertion_seconds
     figures = {
-        "messages": what, "points_per_cloud": None if args.depth else args.points,
+        "messages": what, "points_per_cloud": None if args.depth else len(template.data) // 12,
         "cloud_rate_hz": args.rate, "resolution": args.resolution,
         "published": published, "slots_skipped": skipped, "publishing_seconds": publishing_seconds,
         "messages_inserted": inserted, "messages_dropped_queue": dropped_queue,
