@@ -52,11 +52,9 @@ def bonxai_columns(run, resolution):
     }
 
 
-def state_agreement(matrix):
-    """The % of the points in the same state of an agreement matrix (mvog_bench's JSON)."""
-    same = sum(matrix[state][state] for state in matrix)
-    total = sum(sum(row.values()) for row in matrix.values())
-    return percent(100.0 * same / total) if total else "-"
+def state_agreement(agreement):
+    """The % of the points in the same state in both maps (an agreement of mvog_bench's JSON)."""
+    return percent(100.0 * agreement["fraction"]) if agreement["points"] else "-"
 
 
 def every_reading_row(name, resolution, run):

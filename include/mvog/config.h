@@ -95,14 +95,17 @@ struct MapConfig {
 enum class FreeSpaceRays : std::uint8_t {
   /// Every reading's ray (the paper).
   kEveryReading,
-  /// With MassCounting::kPerScan, one ray per end voxel: the readings of a scan that end in one
-  /// cell at one height cell (and alike in being a hit or not) free space along one ray, to the
-  /// voxel's centre; each hit still adds its own positive volume (eq. 5). A scan adds density 1
-  /// once over the union of the heights its readings saw in a column, so the rays of a voxel,
-  /// at most a cell's diagonal apart, add little to one another's union; a depth camera at 1-4 m
-  /// puts tens to hundreds of pixels in a voxel. OctoMap's discretize option and Bonxai cast
-  /// once per end voxel too. With MassCounting::kPerReading every reading adds its own mass and
-  /// every ray is walked.
+  /// With MassCounting::kPerScan, one ray per end voxel: of the readings of a scan that end in
+  /// one cell at one height cell (and alike in being a hit or not), 4 or more free space along
+  /// one ray, that of the reading ending nearest the voxel's centre; fewer are walked each. Each
+  /// hit still adds its own positive volume (eq. 5). A scan adds density 1 once over the union of
+  /// the heights its readings saw in a column, and n readings spread over a voxel lie about
+  /// 1 / sqrt(n) cells apart, from 4 on half a cell or less: their rays free nearly the same
+  /// cells at nearly the same heights (eq. 6 gives each crossing a cell of height). A depth
+  /// camera at 1-4 m puts tens to hundreds of pixels in a voxel. The scan's free space is a
+  /// subset of every reading's. OctoMap's discretize option and Bonxai cast once per end voxel
+  /// too. With MassCounting::kPerReading every reading adds its own mass and every ray is
+  /// walked.
   kOnePerEndVoxel,
 };
 

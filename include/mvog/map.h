@@ -49,7 +49,9 @@ struct InsertionResult {
   /// (FreeSpaceRays::kOnePerEndVoxel); not a count of readings.
   std::size_t rays_walked = 0;
   /// Time spent rasterising the obstacle readings and the out-of-range readings (thread time,
-  /// summed over the insertion's threads): how much the readings without a return cost.
+  /// summed over the insertion's threads): how much the readings without a return cost. With
+  /// FreeSpaceRays::kOnePerEndVoxel the rays of hits truncated to max_range, which share end
+  /// voxels with the out-of-range readings, are walked and timed with theirs.
   double obstacle_seconds = 0.0;
   double out_of_range_seconds = 0.0;
 

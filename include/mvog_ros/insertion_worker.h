@@ -19,6 +19,7 @@ namespace mvog_ros {
 /// What the insertion worker did since the start or the last reset.
 struct InsertionStatistics {
   std::uint64_t messages_inserted = 0;
+  std::uint64_t backlog_insertions = 0;      // on ~backlog_insertion_threads, another waiting
   std::uint64_t messages_dropped_queue = 0;  // the oldest waiting, when the queue was full
   std::uint64_t readings_inserted = 0;
   std::uint64_t rays_walked = 0;        // for free space: mvog::InsertionResult::rays_walked
@@ -72,6 +73,7 @@ class InsertionWorker {
   bool stopping_ = false;
 
   std::atomic<std::uint64_t> messages_inserted_{0};
+  std::atomic<std::uint64_t> backlog_insertions_{0};
   std::atomic<std::uint64_t> messages_dropped_queue_{0};
   std::atomic<std::uint64_t> readings_inserted_{0};
   std::atomic<std::uint64_t> rays_walked_{0};

@@ -380,7 +380,8 @@ struct VoxelReadings {
   Eigen::Vector3d nearest;
   double nearest_distance;  ///< squared, from `nearest` to the voxel's centre
   CellIndex cell;
-  Volume hits;  ///< the union of the hits' volumes (masses not counted)
+  float hits_bottom;  ///< the union of the hits' volumes (masses are not counted per scan)
+  float hits_top;
   std::uint32_t count;
   bool obstacle;
 };
@@ -408,7 +409,7 @@ class alignas(kCacheLine) EndVoxelRays {
   template <class Add>
   void forEachHit(Add&& add) const {
     for (const VoxelReadings& voxel : voxels_) {
-      if (voxel.obstacle) add(voxel.cell, voxel.hits);
+      if (voxel.obstacle) add(voxel.cell, volumeOfMinimumHeight(voxel.hits_bottom, voxel.hits_top));
     }
   }
   /// Calls walk(end, obstacle) for the ray of each reading to walk, voxel after voxel in the
@@ -441,8 +442,8 @@ class alignas(kCacheLine) EndVoxelRays {
     if (readings.count < readings.ends.size()) readings.ends[readings.count] = end;
     ++readings.count;
     if (hit != nullptr) {
-      readings.hits.bottom = std::min(readings.hits.bottom, hit->bottom);
-      readings.hits.top = std::max(readings.hits.top, hit->top);
+      readings.hits_bottom = std::min(readings.hits_bottom, hit->bottom);
+      readings.hits_top = std::max(readings.hits_top, hit->top);
     }
     const double distance = centreDistance(voxel, end);
     if (distance < readings.nearest_distance ||
@@ -520,7 +521,10 @@ struct ScanUpdate::Impl {
   InsertionResult result;
   /// One per chunk of readings (one per thread).
   std::vector<detail::ScanScratch> scratches;
-  /// One per chunk too: its end voxels and their rays (FreeSpaceRays::kOnePerEndVoxel).
+  /// Those of threads the last scan did not use, kept with their memory.
+  std::vector<detail::ScanScratch> idle_scratches;
+  /// One per chunk too (at least): its end voxels and their rays
+  /// (FreeSpaceRays::kOnePerEndVoxel).
   std::vector<detail::EndVoxelRays> end_voxels;
   /// With several threads: the scratch of each reading of the scan (splitReadingsBySector).
   detail::ReadingSplit split;

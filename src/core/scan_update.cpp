@@ -88,7 +88,8 @@ void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& 
                      end,
                      centreDistance(voxel, end),
                      {voxel.x, voxel.y},
-                     hit != nullptr ? *hit : Volume{},
+                     hit != nullptr ? hit->bottom : 0.0f,
+                     hit != nullptr ? hit->top : 0.0f,
                      1,
                      voxel.obstacle});
 }
@@ -580,10 +581,22 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
   impl.map_config = map_config;
   impl.result = InsertionResult{};
   const auto num_threads = static_cast<std::size_t>(insertion.insertion_threads);
+  // A server switches between one thread and several as its queue backs up: the scratches of the
+  // threads a scan does not use wait with their memory instead of being freed.
+  while (impl.scratches.size() > num_threads) {
+    impl.idle_scratches.push_back(std::move(impl.scratches.back()));
+    impl.scratches.pop_back();
+  }
+  while (impl.scratches.size() < num_threads && !impl.idle_scratches.empty()) {
+    impl.scratches.push_back(std::move(impl.idle_scratches.back()));
+    impl.idle_scratches.pop_back();
+  }
   impl.scratches.resize(num_threads);
   const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
   const bool one_ray_per_end_voxel = detail::walksOneRayPerEndVoxel(map_config, insertion);
-  if (one_ray_per_end_voxel) impl.end_voxels.resize(num_threads);
+  if (one_ray_per_end_voxel && impl.end_voxels.size() < num_threads) {
+    impl.end_voxels.resize(num_threads);
+  }
   const std::size_t num_hits = scan.hits.size();
   const std::size_t num_readings = num_hits + scan.out_of_range.size();
   const double s = 1.0 / map_config.resolution;

@@ -65,6 +65,7 @@ void InsertionWorker::run() {
     obstacle_nanoseconds_ += static_cast<std::uint64_t>(1e9 * result.obstacle_seconds);
     out_of_range_nanoseconds_ += static_cast<std::uint64_t>(1e9 * result.out_of_range_seconds);
     ++messages_inserted_;
+    if (backlog) ++backlog_insertions_;
     {
       std::lock_guard<std::mutex> lock(origin_mutex_);
       latest_origin_ = queued.scan.origin;
@@ -103,6 +104,7 @@ mvog::InsertionResult InsertionWorker::insert(const mvog::Scan& scan, bool backl
 InsertionStatistics InsertionWorker::statistics() const {
   InsertionStatistics statistics;
   statistics.messages_inserted = messages_inserted_.load();
+  statistics.backlog_insertions = backlog_insertions_.load();
   statistics.messages_dropped_queue = messages_dropped_queue_.load();
   statistics.readings_inserted = readings_inserted_.load();
   statistics.rays_walked = rays_walked_.load();
@@ -121,8 +123,8 @@ std::optional<Eigen::Vector3d> InsertionWorker::latestOrigin() const {
 
 void InsertionWorker::resetStatistics() {
   for (std::atomic<std::uint64_t>* counter :
-       {&messages_inserted_, &messages_dropped_queue_, &readings_inserted_, &rays_walked_,
-        &readings_rejected_, &insertion_nanoseconds_, &out_of_range_readings_,
+       {&messages_inserted_, &backlog_insertions_, &messages_dropped_queue_, &readings_inserted_,
+        &rays_walked_, &readings_rejected_, &insertion_nanoseconds_, &out_of_range_readings_,
         &obstacle_nanoseconds_, &out_of_range_nanoseconds_}) {
     counter->store(0);
   }

@@ -89,9 +89,10 @@ OccupancyState stateAt(const Map& map, const Eigen::Vector3d& point) {
 
 // ---- Agreement with every reading's walk ------------------------------------------------------
 
-/// Points at which a map is compared with every reading's walk, by kind, as mvog_bench samples
-/// them: the end of each sampled hit, 5 points along its ray (10 to 90 %), and 4 random points
-/// within 2 cells of its end along each axis.
+/// Points at which a map is compared with every reading's walk, by kind, of the same kinds as
+/// mvog_bench's (which this test cannot link: it needs OctoMap): the end of each sampled hit, 5
+/// points along its ray (10 to 90 %), and 4 random points within 2 cells of its end along each
+/// axis.
 struct ComparedPoints {
   std::vector<Eigen::Vector3d> ends;
   std::vector<Eigen::Vector3d> along_rays;

@@ -65,6 +65,7 @@ TEST_F(InsertionWorkerTest, InsertsWhatIsQueuedAndCountsWhatItDid) {
   EXPECT_EQ(reset.messages_inserted, 0u);
   EXPECT_EQ(reset.readings_inserted, 0u);
   EXPECT_EQ(reset.rays_walked, 0u);
+  EXPECT_EQ(reset.backlog_insertions, 0u);
   EXPECT_EQ(reset.readings_rejected, 0u);
   EXPECT_EQ(reset.insertion_seconds, 0.0);
 }
@@ -135,9 +136,16 @@ TEST_F(InsertionWorkerTest, ABacklogInsertedOnMoreThreadsBuildsTheSameMap) {
   config.insertion_queue_size = 100;
   config.backlog_insertion_threads = 4;
   InsertionWorker worker(config, shared_map);
-  for (const mvog::Scan& scan : scans) worker.enqueue(mvog::Scan(scan), "test");
+  {
+    // The worker waits for the map while the scans queue up: it may have taken the first, and
+    // every one after it but the last has another behind it.
+    std::unique_lock<WriterPreferringMutex> lock(shared_map.mutex);
+    for (const mvog::Scan& scan : scans) worker.enqueue(mvog::Scan(scan), "test");
+  }
   worker.stop();
   EXPECT_EQ(worker.statistics().messages_inserted, scans.size());
+  EXPECT_GE(worker.statistics().backlog_insertions, scans.size() - 2);
+  EXPECT_LE(worker.statistics().backlog_insertions, scans.size() - 1);
   EXPECT_EQ(mvog::serializeMap(shared_map.map), mvog::serializeMap(one_by_one));
 }
 

@@ -69,6 +69,7 @@ void StatisticsPublication::diagnose(diagnostic_updater::DiagnosticStatusWrapper
   status.add("out_of_range_readings", s.out_of_range_readings);
   status.add("out_of_range_time_share", s.out_of_range_time_share);
   status.add("messages_inserted", s.messages_inserted);
+  status.add("backlog_insertions", s.backlog_insertions);
   status.add("messages_dropped_tf", s.messages_dropped_tf);
   status.add("messages_dropped_queue", s.messages_dropped_queue);
   status.add("messages_dropped_invalid", s.messages_dropped_invalid);
@@ -107,6 +108,7 @@ mvog::MapStatistics StatisticsPublication::statistics() {
   statistics.out_of_range_time_share =
       rasterising > 0.0 ? insertion.out_of_range_seconds / rasterising : 0.0;
   statistics.messages_inserted = insertion.messages_inserted;
+  statistics.backlog_insertions = insertion.backlog_insertions;
   statistics.messages_dropped_tf = inputs.messages_dropped_tf;
   statistics.messages_dropped_queue = insertion.messages_dropped_queue;
   statistics.messages_dropped_invalid = inputs.messages_dropped_invalid;
