@@ -139,17 +139,18 @@ struct Quality {
   StateCounts along_rays;     ///< the ray passed: free is right
   StateCounts far_from_data;  ///< nothing was seen: unknown is right
 };
+/// The states a map whose state at p is `state_of(p)` gives at `points`.
+template <class StateOf>
+StateCounts statesAt(const std::vector<Eigen::Vector3d>& points, const StateOf& state_of) {
+  StateCounts counts;
+  for (const Eigen::Vector3d& p : points) counts.add(state_of(p));
+  return counts;
+}
 /// The quality of a map whose state at p is `state_of(p)`.
 template <class StateOf>
 Quality qualityOf(const SamplePoints& points, StateOf&& state_of) {
-  Quality quality;
-  auto count = [&](const std::vector<Eigen::Vector3d>& at, StateCounts& into) {
-    for (const Eigen::Vector3d& p : at) into.add(state_of(p));
-  };
-  count(points.endpoints, quality.endpoints);
-  count(points.along_rays, quality.along_rays);
-  count(points.far_from_data, quality.far_from_data);
-  return quality;
+  return {statesAt(points.endpoints, state_of), statesAt(points.along_rays, state_of),
+          statesAt(points.far_from_data, state_of)};
 }
 Quality mvogQuality(const mvog::Map& map, double occupancy_threshold, const SamplePoints& points);
 /// OctoMap's state at `point`: search(), null = unknown, else isNodeOccupied().

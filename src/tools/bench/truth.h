@@ -96,19 +96,15 @@ struct TruthScores {
   double occupancyF1() const;
 };
 
+/// The scores of a map whose state at p is `state_of(p)`.
 template <class StateOf>
-TruthScores scoreMap(const TruthLabels& labels, StateOf&& state_of) {
-  TruthScores scores;
-  auto count = [&](const std::vector<Eigen::Vector3d>& at, StateCounts& into) {
-    for (const Eigen::Vector3d& p : at) into.add(state_of(p));
-  };
-  count(labels.surface, scores.surface);
-  count(labels.thin, scores.thin);
-  count(labels.free_near_surface, scores.free_near_surface);
-  count(labels.free_far_from_surfaces, scores.free_far_from_surfaces);
-  count(labels.free_under_overhang, scores.free_under_overhang);
-  count(labels.unobserved, scores.unobserved);
-  return scores;
+TruthScores scoreMap(const TruthLabels& labels, const StateOf& state_of) {
+  return {statesAt(labels.surface, state_of),
+          statesAt(labels.thin, state_of),
+          statesAt(labels.free_near_surface, state_of),
+          statesAt(labels.free_far_from_surfaces, state_of),
+          statesAt(labels.free_under_overhang, state_of),
+          statesAt(labels.unobserved, state_of)};
 }
 
 /// The check of the labels: a classifier with perfect knowledge of the geometry and of where
