@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -22,14 +23,41 @@ struct Sphere {
   double radius = 0.0;
 };
 
+/// A vertical cylinder (a pole, a table leg, a trunk): its axis at `centre` (x, y), from
+/// `bottom` to `top` (m).
+struct Cylinder {
+  Eigen::Vector2d centre;
+  double radius = 0.0;
+  double bottom = 0.0;
+  double top = 0.0;
+};
+
+/// Where the ray from `origin` along `direction` is inside `box`: [t_near, t_far] along it
+/// (t_near clamped to 0), false if it never is (the slabs' method).
+bool rayThroughBox(const Box& box, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                   double& t_near, double& t_far);
+
 /// Obstacles: a ray stops at the first surface it meets.
 struct Scene {
   std::vector<Box> boxes;
   std::vector<Sphere> spheres;  // seen from outside only
+  /// Initialised here so that a scene listing its boxes and spheres only needs nothing more
+  /// (-Wmissing-field-initializers).
+  std::vector<Cylinder> cylinders = {};
 
   /// Distance from `origin` along the unit vector `direction` to the nearest surface, or
-  /// +infinity. An origin inside a box is 0 away from it.
+  /// +infinity. An origin inside a box or a cylinder is 0 away from it.
   double castRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
+
+  /// The signed distance from `point` to the nearest obstacle (m): negative inside one, 0 on a
+  /// surface, +infinity without obstacles.
+  double distance(const Eigen::Vector3d& point) const;
+
+  /// Adds the obstacles of `other`.
+  void add(const Scene& other);
+
+  /// Moves every obstacle by `offset`.
+  void translate(const Eigen::Vector3d& offset);
 };
 
 /// The inside of the room [min, max] as six walls `thickness` thick, overlapping at the corners:
@@ -46,17 +74,24 @@ Scene streetScene();
 /// and a ball.
 Scene officeScene();
 
-/// A depth camera, by default the paper's SwissRanger 4000 (176 x 144 pixels).
+/// A depth camera, by default the paper's SwissRanger 4000 (176 x 144 pixels), exact.
 struct DepthCamera {
   int width = 176;
   int height = 144;
   double horizontal_fov_degrees = 43.6;
   double vertical_fov_degrees = 34.6;
+  /// Gaussian noise on each hit's depth z (along the optical axis; the point moves along its
+  /// pixel's ray): sigma = noise_sigma + noise_growth * (z - noise_min_depth)^2 (m), as a
+  /// structured-light camera's (0, 0: exact). Seeded: the same scan every time.
+  double noise_sigma = 0.0;
+  double noise_growth = 0.0;  ///< 1/m
+  double noise_min_depth = 0.4;
+  std::uint32_t noise_seed = 1;
 };
 
 /// What `camera` at `position` sees of `scene`, looking along `yaw` about z, tilted down by
-/// `tilt` (rad): a hit where a pixel's ray meets a surface within `max_range`, else an
-/// out-of-range reading at `max_range`.
+/// `tilt` (rad): a hit where a pixel's ray meets a surface within `max_range` (with the camera's
+/// noise), else an out-of-range reading at `max_range`.
 mvog::Scan depthScan(const Scene& scene, const DepthCamera& camera, const Eigen::Vector3d& position,
                      double yaw, double tilt, double max_range);
 

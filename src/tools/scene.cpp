@@ -3,27 +3,76 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <utility>
 
 #include <Eigen/Geometry>
 
 namespace mvog_scene {
 
+bool rayThroughBox(const Box& box, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                   double& t_near, double& t_far) {
+  // The ray is inside the box between the last entry into a slab and the first exit from one.
+  // Dividing by a zero component gives infinite bounds: no constraint.
+  t_near = 0.0;
+  t_far = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3 && t_near <= t_far; ++axis) {
+    double t0 = (box.min[axis] - origin[axis]) / direction[axis];
+    double t1 = (box.max[axis] - origin[axis]) / direction[axis];
+    if (t0 > t1) std::swap(t0, t1);
+    t_near = std::max(t_near, t0);
+    t_far = std::min(t_far, t1);
+  }
+  return t_near <= t_far;
+}
+
+namespace {
+
+/// Where the ray is inside `cylinder`, as rayThroughBox: within its radius about the axis (a
+/// quadratic in the ray's horizontal part) and between its bottom and top.
+bool rayThroughCylinder(const Cylinder& cylinder, const Eigen::Vector3d& origin,
+                        const Eigen::Vector3d& direction, double& t_near, double& t_far) {
+  const Box slab{{-INFINITY, -INFINITY, cylinder.bottom}, {INFINITY, INFINITY, cylinder.top}};
+  if (!rayThroughBox(slab, origin, direction, t_near, t_far)) return false;
+  const Eigen::Vector2d from_axis = origin.head<2>() - cylinder.centre;
+  const Eigen::Vector2d across = direction.head<2>();
+  const double a = across.squaredNorm();
+  const double c = from_axis.squaredNorm() - cylinder.radius * cylinder.radius;
+  if (a == 0.0) return c <= 0.0;  // a vertical ray: inside the radius all along, or never
+  const double b = from_axis.dot(across);
+  const double discriminant = b * b - a * c;
+  if (discriminant < 0.0) return false;
+  const double root = std::sqrt(discriminant);
+  t_near = std::max(t_near, (-b - root) / a);
+  t_far = std::min(t_far, (-b + root) / a);
+  return t_near <= t_far;
+}
+
+/// How far `value` is outside [low, high]: negative inside, minus the distance to the nearer end.
+double outside(double value, double low, double high) {
+  return std::max(low - value, value - high);
+}
+
+/// The signed distance of a point whose signed distances to two slabs crossing at right angles
+/// are `first` and `second`, to their intersection.
+double intersectionDistance(double first, double second) {
+  return std::hypot(std::max(first, 0.0), std::max(second, 0.0)) +
+         std::min(std::max(first, second), 0.0);
+}
+
+}  // namespace
+
 double Scene::castRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const {
   double nearest = std::numeric_limits<double>::infinity();
+  double t_near = 0.0;
+  double t_far = 0.0;
   for (const Box& box : boxes) {
-    // The slabs' method: the ray is inside the box between the last entry into a slab and the
-    // first exit from one. Dividing by a zero component gives infinite bounds: no constraint.
-    double t_near = 0.0;
-    double t_far = nearest;
-    for (int axis = 0; axis < 3 && t_near <= t_far; ++axis) {
-      double t0 = (box.min[axis] - origin[axis]) / direction[axis];
-      double t1 = (box.max[axis] - origin[axis]) / direction[axis];
-      if (t0 > t1) std::swap(t0, t1);
-      t_near = std::max(t_near, t0);
-      t_far = std::min(t_far, t1);
+    if (rayThroughBox(box, origin, direction, t_near, t_far)) nearest = std::min(nearest, t_near);
+  }
+  for (const Cylinder& cylinder : cylinders) {
+    if (rayThroughCylinder(cylinder, origin, direction, t_near, t_far)) {
+      nearest = std::min(nearest, t_near);
     }
-    if (t_near <= t_far) nearest = t_near;
   }
   for (const Sphere& sphere : spheres) {
     const Eigen::Vector3d to_centre = sphere.centre - origin;
@@ -35,6 +84,45 @@ double Scene::castRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dire
     }
   }
   return nearest;
+}
+
+double Scene::distance(const Eigen::Vector3d& point) const {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Box& box : boxes) {
+    Eigen::Vector3d per_axis;
+    for (int axis = 0; axis < 3; ++axis) {
+      per_axis[axis] = outside(point[axis], box.min[axis], box.max[axis]);
+    }
+    nearest = std::min(nearest, per_axis.cwiseMax(0.0).norm() + std::min(per_axis.maxCoeff(), 0.0));
+  }
+  for (const Cylinder& cylinder : cylinders) {
+    nearest = std::min(
+        nearest, intersectionDistance((point.head<2>() - cylinder.centre).norm() - cylinder.radius,
+                                      outside(point.z(), cylinder.bottom, cylinder.top)));
+  }
+  for (const Sphere& sphere : spheres) {
+    nearest = std::min(nearest, (point - sphere.centre).norm() - sphere.radius);
+  }
+  return nearest;
+}
+
+void Scene::add(const Scene& other) {
+  boxes.insert(boxes.end(), other.boxes.begin(), other.boxes.end());
+  spheres.insert(spheres.end(), other.spheres.begin(), other.spheres.end());
+  cylinders.insert(cylinders.end(), other.cylinders.begin(), other.cylinders.end());
+}
+
+void Scene::translate(const Eigen::Vector3d& offset) {
+  for (Box& box : boxes) {
+    box.min += offset;
+    box.max += offset;
+  }
+  for (Sphere& sphere : spheres) sphere.centre += offset;
+  for (Cylinder& cylinder : cylinders) {
+    cylinder.centre += offset.head<2>();
+    cylinder.bottom += offset.z();
+    cylinder.top += offset.z();
+  }
 }
 
 std::vector<Box> roomWalls(const Eigen::Vector3d& min, const Eigen::Vector3d& max,
@@ -89,15 +177,24 @@ Scene officeScene() {
 namespace {
 
 /// The reading of the ray from `position` along the unit vector `direction`: a hit on the
-/// nearest surface within `max_range`, else an out-of-range reading at `max_range`.
+/// nearest surface within `max_range`, `measured(range)` away, else an out-of-range reading at
+/// `max_range`.
+template <class Measured>
 void castReading(const Scene& scene, const Eigen::Vector3d& position,
-                 const Eigen::Vector3d& direction, double max_range, mvog::Scan& scan) {
+                 const Eigen::Vector3d& direction, double max_range, mvog::Scan& scan,
+                 const Measured& measured) {
   const double range = scene.castRay(position, direction);
   if (range <= max_range) {
-    scan.hits.push_back((position + range * direction).cast<float>());
+    scan.hits.push_back(Eigen::Vector3d(position + measured(range) * direction).cast<float>());
   } else {
     scan.out_of_range.push_back((position + max_range * direction).cast<float>());
   }
+}
+
+/// An exact reading.
+void castReading(const Scene& scene, const Eigen::Vector3d& position,
+                 const Eigen::Vector3d& direction, double max_range, mvog::Scan& scan) {
+  castReading(scene, position, direction, max_range, scan, [](double range) { return range; });
 }
 
 /// The unit vector at `azimuth` about z from +x and `elevation` above the xy-plane (rad).
@@ -167,14 +264,25 @@ mvog::Scan depthScan(const Scene& scene, const DepthCamera& camera, const Eigen:
                                        .toRotationMatrix();
   const double tan_x = std::tan(0.5 * camera.horizontal_fov_degrees * M_PI / 180.0);
   const double tan_y = std::tan(0.5 * camera.vertical_fov_degrees * M_PI / 180.0);
+  const bool noisy = camera.noise_sigma > 0.0 || camera.noise_growth > 0.0;
+  std::mt19937 rng(camera.noise_seed);
+  std::normal_distribution<double> standard_normal;
   mvog::Scan scan;
   scan.origin = position;
   for (int v = 0; v < camera.height; ++v) {
     for (int u = 0; u < camera.width; ++u) {
       const double a = (2.0 * u / (camera.width - 1) - 1.0) * tan_x;
       const double b = (2.0 * v / (camera.height - 1) - 1.0) * tan_y;
-      castReading(scene, position, (rotation * Eigen::Vector3d(1.0, -a, -b)).normalized(),
-                  max_range, scan);
+      // (1, -a, -b) is the pixel's ray scaled to depth 1: its length is range / depth.
+      const Eigen::Vector3d ray = rotation * Eigen::Vector3d(1.0, -a, -b);
+      const double range_per_depth = ray.norm();
+      castReading(scene, position, ray / range_per_depth, max_range, scan, [&](double range) {
+        if (!noisy) return range;
+        const double depth = range / range_per_depth;
+        const double from_min = depth - camera.noise_min_depth;
+        const double sigma = camera.noise_sigma + camera.noise_growth * from_min * from_min;
+        return (depth + sigma * standard_normal(rng)) * range_per_depth;
+      });
     }
   }
   return scan;

@@ -36,13 +36,13 @@ octomap::point3d toOctomap(const Eigen::Vector3d& p) {
 
 std::size_t stateIndex(mvog::OccupancyState state) { return static_cast<std::size_t>(state); }
 
+}  // namespace
+
 mvog::OccupancyState octomapState(const octomap::OcTree& tree, const Eigen::Vector3d& p) {
   const octomap::OcTreeNode* node = tree.search(toOctomap(p));
   if (node == nullptr) return mvog::OccupancyState::kUnknown;
   return tree.isNodeOccupied(node) ? mvog::OccupancyState::kOccupied : mvog::OccupancyState::kFree;
 }
-
-}  // namespace
 
 MvogRun runMvog(const InputData& input, const RunOptions& options) {
   mvog::MapConfig map_config;
@@ -128,22 +128,43 @@ std::size_t boundingBoxVoxels(const InputData& input, const RunOptions& options)
 namespace {
 
 constexpr double kFarMargin = 3.0;    // m
-constexpr double kFarDistance = 1.0;  // m: the voxel edge of the ray coverage below
+constexpr double kFarDistance = 1.0;  // m: the voxel edge of the ray coverage
 constexpr std::size_t kFarCandidates = 200000;
 constexpr std::size_t kFarPoints = 20000;
 
-/// The 1 m voxels (kFarDistance) that some ray crosses, by a 3D Amanatides-Woo walk.
-std::unordered_set<std::uint64_t> voxelsCrossed(const InputData& input, double max_range) {
-  auto key = [](const Eigen::Vector3i& v) {
-    return (std::uint64_t{static_cast<std::uint16_t>(v.x())} << 32) |
-           (std::uint64_t{static_cast<std::uint16_t>(v.y())} << 16) |
-           std::uint64_t{static_cast<std::uint16_t>(v.z())};
+}  // namespace
+
+std::uint64_t voxelKey(const Eigen::Vector3i& voxel) {
+  return (std::uint64_t{static_cast<std::uint16_t>(voxel.x())} << 32) |
+         (std::uint64_t{static_cast<std::uint16_t>(voxel.y())} << 16) |
+         std::uint64_t{static_cast<std::uint16_t>(voxel.z())};
+}
+
+std::size_t RayCoverage::bitInBlock(const Eigen::Vector3i& voxel) {
+  constexpr int kMask = (1 << kBlockShift) - 1;
+  return static_cast<std::size_t>(
+      (((voxel.z() & kMask) << kBlockShift | (voxel.y() & kMask)) << kBlockShift) |
+      (voxel.x() & kMask));
+}
+
+RayCoverage::RayCoverage(const InputData& input, double max_range, double voxel_edge)
+    : voxel_edge_(voxel_edge) {
+  // The block of the voxel before: a ray's next voxel is in it mostly.
+  std::uint64_t block_key = ~std::uint64_t{0};
+  Block* block = nullptr;
+  auto mark = [&](const Eigen::Vector3i& voxel) {
+    // An arithmetic shift: blocks of negative voxels too.
+    const std::uint64_t key = voxelKey(voxel.unaryExpr([](int v) { return v >> kBlockShift; }));
+    if (key != block_key) {
+      block_key = key;
+      block = &blocks_[key];
+    }
+    block->set(bitInBlock(voxel));
   };
-  std::unordered_set<std::uint64_t> crossed;
   for (const mvog::Scan& scan : input.scans) {
-    const Eigen::Vector3d start = scan.origin / kFarDistance;
+    const Eigen::Vector3d start = scan.origin / voxel_edge;
     for (const Eigen::Vector3f& hit : scan.hits) {
-      const Eigen::Vector3d end = rayEnd(scan.origin, hit, max_range) / kFarDistance;
+      const Eigen::Vector3d end = rayEnd(scan.origin, hit, max_range) / voxel_edge;
       const Eigen::Vector3d delta = end - start;
       Eigen::Vector3i voxel = start.array().floor().cast<int>();
       const Eigen::Vector3i last = end.array().floor().cast<int>();
@@ -155,21 +176,36 @@ std::unordered_set<std::uint64_t> voxelsCrossed(const InputData& input, double m
         t_next[axis] = delta[axis] != 0.0 ? (wall - start[axis]) / delta[axis] : INFINITY;
         t_delta[axis] = delta[axis] != 0.0 ? 1.0 / std::fabs(delta[axis]) : INFINITY;
       }
-      crossed.insert(key(voxel));
+      mark(voxel);
       const int steps = (last - voxel).cwiseAbs().sum();
       for (int k = 0; k < steps; ++k) {
         int axis = 0;
         t_next.minCoeff(&axis);
         voxel[axis] += step[axis];
         t_next[axis] += t_delta[axis];
-        crossed.insert(key(voxel));
+        mark(voxel);
       }
     }
   }
-  return crossed;
 }
 
-}  // namespace
+bool RayCoverage::crossed(const Eigen::Vector3i& voxel) const {
+  const auto block =
+      blocks_.find(voxelKey(voxel.unaryExpr([](int v) { return v >> kBlockShift; })));
+  return block != blocks_.end() && block->second.test(bitInBlock(voxel));
+}
+
+bool RayCoverage::near(const Eigen::Vector3d& point, int reach) const {
+  const Eigen::Vector3i voxel = (point / voxel_edge_).array().floor().cast<int>();
+  for (int dx = -reach; dx <= reach; ++dx) {
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dz = -reach; dz <= reach; ++dz) {
+        if (crossed(voxel + Eigen::Vector3i(dx, dy, dz))) return true;
+      }
+    }
+  }
+  return false;
+}
 
 WalkStats runWalk(const InputData& input, const RunOptions& options) {
   const double s = 1.0 / options.resolution;
@@ -238,22 +274,7 @@ SamplePoints samplePoints(const InputData& input, const RunOptions& options, std
       }
     }
   }
-  const std::unordered_set<std::uint64_t> crossed = voxelsCrossed(input, options.max_range);
-  auto near_a_ray = [&](const Eigen::Vector3d& p) {
-    const Eigen::Vector3i voxel = (p / kFarDistance).array().floor().cast<int>();
-    for (int dx = -1; dx <= 1; ++dx) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dz = -1; dz <= 1; ++dz) {
-          const Eigen::Vector3i v = voxel + Eigen::Vector3i(dx, dy, dz);
-          const std::uint64_t key = (std::uint64_t{static_cast<std::uint16_t>(v.x())} << 32) |
-                                    (std::uint64_t{static_cast<std::uint16_t>(v.y())} << 16) |
-                                    std::uint64_t{static_cast<std::uint16_t>(v.z())};
-          if (crossed.count(key) != 0) return true;
-        }
-      }
-    }
-    return false;
-  };
+  const RayCoverage coverage(input, options.max_range, kFarDistance);
   const Eigen::Vector3d low = box.min().array() - kFarMargin;
   const Eigen::Vector3d high = box.max().array() + kFarMargin;
   std::mt19937 rng(1);
@@ -262,7 +283,7 @@ SamplePoints samplePoints(const InputData& input, const RunOptions& options, std
     const Eigen::Vector3d p(low.x() + unit(rng) * (high.x() - low.x()),
                             low.y() + unit(rng) * (high.y() - low.y()),
                             low.z() + unit(rng) * (high.z() - low.z()));
-    if (!near_a_ray(p)) points.far_from_data.push_back(p);
+    if (!coverage.near(p, 1)) points.far_from_data.push_back(p);
   }
   return points;
 }

@@ -1,10 +1,13 @@
 #pragma once
 
 #include <array>
+#include <bitset>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
+#include <unordered_set>
 
 #include <octomap/OcTree.h>
 
@@ -84,6 +87,29 @@ struct WalkStats {
 };
 WalkStats runWalk(const InputData& input, const RunOptions& options);
 
+/// The voxels of edge `voxel_edge` that some ray of `input` crosses (truncated to max_range),
+/// by a 3D Amanatides-Woo walk from its origin to its end.
+class RayCoverage {
+ public:
+  RayCoverage(const InputData& input, double max_range, double voxel_edge);
+  /// Whether a crossed voxel lies within `reach` voxels of the one holding `point` along every
+  /// axis; if not, `point` is more than reach * voxel_edge from every ray.
+  bool near(const Eigen::Vector3d& point, int reach) const;
+
+ private:
+  /// Blocks of 16^3 voxels, a bit each: a lidar's rays of 100 m cross tens of millions.
+  static constexpr int kBlockShift = 4;
+  using Block = std::bitset<std::size_t{1} << (3 * kBlockShift)>;
+  static std::size_t bitInBlock(const Eigen::Vector3i& voxel);
+  bool crossed(const Eigen::Vector3i& voxel) const;
+
+  double voxel_edge_;
+  std::unordered_map<std::uint64_t, Block> blocks_;
+};
+
+/// The key of a voxel in a hash set (16 bits an axis: keys repeat every 65,536 voxels).
+std::uint64_t voxelKey(const Eigen::Vector3i& voxel);
+
 /// Where the maps are asked: at most `max_rays` rays sampled evenly over the input, and points
 /// far from every ray.
 struct SamplePoints {
@@ -113,19 +139,22 @@ struct Quality {
   StateCounts along_rays;     ///< the ray passed: free is right
   StateCounts far_from_data;  ///< nothing was seen: unknown is right
 };
+/// The states a map whose state at p is `state_of(p)` gives at `points`.
+template <class StateOf>
+StateCounts statesAt(const std::vector<Eigen::Vector3d>& points, const StateOf& state_of) {
+  StateCounts counts;
+  for (const Eigen::Vector3d& p : points) counts.add(state_of(p));
+  return counts;
+}
 /// The quality of a map whose state at p is `state_of(p)`.
 template <class StateOf>
 Quality qualityOf(const SamplePoints& points, StateOf&& state_of) {
-  Quality quality;
-  auto count = [&](const std::vector<Eigen::Vector3d>& at, StateCounts& into) {
-    for (const Eigen::Vector3d& p : at) into.add(state_of(p));
-  };
-  count(points.endpoints, quality.endpoints);
-  count(points.along_rays, quality.along_rays);
-  count(points.far_from_data, quality.far_from_data);
-  return quality;
+  return {statesAt(points.endpoints, state_of), statesAt(points.along_rays, state_of),
+          statesAt(points.far_from_data, state_of)};
 }
 Quality mvogQuality(const mvog::Map& map, double occupancy_threshold, const SamplePoints& points);
+/// OctoMap's state at `point`: search(), null = unknown, else isNodeOccupied().
+mvog::OccupancyState octomapState(const octomap::OcTree& tree, const Eigen::Vector3d& point);
 Quality octomapQuality(const octomap::OcTree& tree, const SamplePoints& points);
 
 /// Occupied / free / unknown of both maps at the same points: counts[mvog][octomap].

@@ -22,12 +22,15 @@ BonxaiRun runBonxai(const InputData& input, const RunOptions& options) {
   return run;
 }
 
+mvog::OccupancyState bonxaiState(const Bonxai::ProbabilisticMap& map,
+                                 const Eigen::Vector3d& point) {
+  const Bonxai::CoordT voxel = map.grid().posToCoord(point.x(), point.y(), point.z());
+  if (map.isOccupied(voxel)) return mvog::OccupancyState::kOccupied;
+  return map.isFree(voxel) ? mvog::OccupancyState::kFree : mvog::OccupancyState::kUnknown;
+}
+
 Quality bonxaiQuality(const Bonxai::ProbabilisticMap& map, const SamplePoints& points) {
-  return qualityOf(points, [&](const Eigen::Vector3d& p) {
-    const Bonxai::CoordT voxel = map.grid().posToCoord(p.x(), p.y(), p.z());
-    if (map.isOccupied(voxel)) return mvog::OccupancyState::kOccupied;
-    return map.isFree(voxel) ? mvog::OccupancyState::kFree : mvog::OccupancyState::kUnknown;
-  });
+  return qualityOf(points, [&](const Eigen::Vector3d& p) { return bonxaiState(map, p); });
 }
 
 }  // namespace mvog_bench

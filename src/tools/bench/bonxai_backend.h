@@ -50,8 +50,11 @@ struct BonxaiRun {
 /// kBonxaiBuilt.
 BonxaiRun runBonxai(const InputData& input, const RunOptions& options);
 
-/// The state of the voxel holding each point: isOccupied, isFree, else unknown (no cell, or
+/// The state of the voxel holding `point`: isOccupied, isFree, else unknown (no cell, or
 /// log-odds exactly at Bonxai's threshold, 0.5). Defined only when kBonxaiBuilt.
+mvog::OccupancyState bonxaiState(const Bonxai::ProbabilisticMap& map, const Eigen::Vector3d& point);
+
+/// bonxaiState at each point. Defined only when kBonxaiBuilt.
 Quality bonxaiQuality(const Bonxai::ProbabilisticMap& map, const SamplePoints& points);
 
 }  // namespace mvog_bench

@@ -1,6 +1,9 @@
 #include "input.h"
 
 #include <fstream>
+#include <utility>
+
+#include "truth.h"
 
 namespace mvog_bench {
 
@@ -10,11 +13,26 @@ std::size_t InputData::readings() const {
   return total;
 }
 
+InputData inputOfScans(const std::string& format, std::vector<mvog::Scan> scans) {
+  InputData input;
+  input.format = format;
+  for (mvog::Scan& scan : scans) {
+    ++input.sensor_messages;
+    input.out_of_range_readings += scan.out_of_range.size();
+    input.out_of_range.push_back(std::move(scan.out_of_range));
+    scan.out_of_range.clear();
+    input.scans.push_back(std::move(scan));
+  }
+  return input;
+}
+
 InputData loadInput(const std::string& path, const std::string& fixed_frame,
                     double depth_no_return_length) {
   InputData input;
   if (std::string_view(path).substr(0, kSyntheticPrefix.size()) == kSyntheticPrefix) {
     input = loadSynthetic(path.substr(kSyntheticPrefix.size()));
+  } else if (std::string_view(path).substr(0, kTruthPrefix.size()) == kTruthPrefix) {
+    input = loadTruth(truthScene(path.substr(kTruthPrefix.size())));
   } else {
     std::ifstream file(path, std::ios::binary);
     if (!file) throw InputError(path + ": cannot open the file (missing or unreadable)");

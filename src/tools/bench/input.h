@@ -24,7 +24,7 @@ class InputError : public std::runtime_error {
 /// are disregarded in all four representations"), so `Scan::out_of_range` is always empty;
 /// given to MVOG alone with mvog_bench --out-of-range-free-length.
 struct InputData {
-  std::string format;  ///< "bag", "graph" or "synthetic"
+  std::string format;  ///< "bag", "graph", "synthetic" or "truth"
   std::vector<mvog::Scan> scans;
   /// The out-of-range readings of each scan (at the sensor's range_max).
   std::vector<std::vector<Eigen::Vector3f>> out_of_range;
@@ -46,7 +46,7 @@ struct InputData {
 constexpr std::string_view kSyntheticPrefix = "synthetic:";
 
 /// Reads a ROS bag (by its "#ROSBAG V2.0" header) or an OctoMap ScanGraph (.graph), or makes the
-/// synthetic input "synthetic:NAME".
+/// synthetic input "synthetic:NAME" or the ground-truth scene's "truth:NAME" (truth.h).
 /// `depth_no_return_length`: where the out-of-range readings of a bag's depth images end (m;
 /// infinite: their +Inf pixels are skipped). Throws InputError for a missing, unreadable,
 /// truncated or unusable file.
@@ -68,6 +68,10 @@ InputData loadBag(const std::string& path, const std::string& fixed_frame,
 /// time), 0.5 m up on 10 poses across an office (30 m range). Beams that meet nothing within
 /// range are out-of-range readings. Throws InputError for an unknown name.
 InputData loadSynthetic(const std::string& name);
+
+/// The scans of a sensor cast into a scene (`format` "synthetic" or "truth"), their
+/// out-of-range readings put aside.
+InputData inputOfScans(const std::string& format, std::vector<mvog::Scan> scans);
 
 /// Every node of an OctoMap ScanGraph binary file, parsed with every count checked against the
 /// file size first (a truncated or corrupt file is an error, never a partial graph).

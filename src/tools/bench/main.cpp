@@ -6,6 +6,7 @@
 //              [--model default|paper] [--clip-free-space-at-hits on|off]
 //              [--mass-counting per-scan|per-reading] [--split-free-space-at-obstacles on|off]
 //              [--free-space-rays one-per-end-voxel|every-reading]
+//              [--truth-slice OUT.ppm]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
 #include <algorithm>
 #include <chrono>
@@ -22,6 +23,7 @@
 #include "bonxai_backend.h"
 #include "input.h"
 #include "report.h"
+#include "truth.h"
 
 namespace {
 
@@ -46,6 +48,7 @@ struct Arguments {
   bool run_every_reading = false;
   std::string json;
   std::string fixed_frame = "map";
+  std::string truth_slice;  ///< a ground-truth scene's slice is drawn here
 };
 
 class UsageError : public std::runtime_error {
@@ -62,11 +65,15 @@ constexpr const char* kUsage =
     "                  [--split-free-space-at-obstacles on|off] [--occupancy-threshold T]\n"
     "                  [--out-of-range-free-length L|inf]\n"
     "                  [--free-space-rays one-per-end-voxel|every-reading]\n"
+    "                  [--truth-slice OUT.ppm]\n"
     "  FILE        a ROS bag (LaserScan, PointCloud2 and/or depth Image 16UC1 or 32FC1 with\n"
     "              CameraInfo; poses from /tf and /tf_static)\n"
     "              or an OctoMap ScanGraph (.graph), or synthetic:NAME, a sensor cast into a\n"
     "              scene built in code (rotating-lidar-16, rotating-lidar-16-firing-order,\n"
-    "              rotating-lidar-32, tilting-laser)\n"
+    "              rotating-lidar-32, tilting-laser), or truth:NAME, a scene with exact geometry\n"
+    "              and its sensor, every backend's map scored at points labelled from it\n"
+    "              (room-depth-camera, bridge-lidar-16, car-lidar, corridor-2d-laser,\n"
+    "              tilting-laser)\n"
     "  R           cell size in metres, repeatable (default 0.1)\n"
     "  M           hits further than M metres insert free space only, truncated (default: none)\n"
     "  N           MVOG insertion threads (default 1; OctoMap and Bonxai always use one)\n"
@@ -86,7 +93,10 @@ constexpr const char* kUsage =
     "  --model     MVOG's rules: the defaults, or the paper's exact model; the options after\n"
     "              it change one rule each (mvog::ModelRules, README's decisions table)\n"
     "  --free-space-rays  MVOG walks one ray per end voxel (the default) or every reading's\n"
-    "              (mvog::FreeSpaceRays)\n";
+    "              (mvog::FreeSpaceRays)\n"
+    "  --truth-slice  with truth:NAME, a cross-section of the scene with each map's errors\n"
+    "              coloured, as a binary PPM: a panel per resolution and map (mvog, octomap,\n"
+    "              bonxai, those run), top to bottom\n";
 
 double positiveNumber(const std::string& option, const std::string& text) {
   char* end = nullptr;
@@ -181,11 +191,17 @@ Arguments parseArguments(int argc, char** argv) {
       arguments.json = value;
     } else if (option == "--fixed-frame") {
       arguments.fixed_frame = value;
+    } else if (option == "--truth-slice") {
+      arguments.truth_slice = value;
     } else {
       throw UsageError("unknown option: " + option);
     }
   }
   if (arguments.input.empty()) throw UsageError("--input is required");
+  if (!arguments.truth_slice.empty() &&
+      arguments.input.compare(0, mvog_bench::kTruthPrefix.size(), mvog_bench::kTruthPrefix) != 0) {
+    throw UsageError("--truth-slice needs --input truth:NAME");
+  }
   if (arguments.resolutions.empty()) arguments.resolutions.push_back(0.1);
   if (!arguments.run_mvog && !arguments.run_octomap && !arguments.run_bonxai &&
       !arguments.run_walk && !arguments.run_every_reading) {
@@ -207,10 +223,17 @@ void keepFaster(std::optional<Run>& fastest, Run next, SecondsOf seconds_of) {
   if (!fastest || seconds_of(next) < seconds_of(*fastest)) fastest = std::move(next);
 }
 
+/// A ground-truth scene's geometry, where its rays went, and the panels of its slice so far.
+struct TruthContext {
+  mvog_bench::TruthScene scene;
+  mvog_bench::RayCoverage coverage;
+  std::vector<mvog_bench::SlicePanel> slice_panels;
+};
+
 mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
                                                  const mvog_bench::InputData& input,
                                                  const mvog_bench::SamplePoints& points,
-                                                 double resolution) {
+                                                 double resolution, TruthContext* truth) {
   mvog_bench::RunOptions options;
   options.resolution = resolution;
   options.max_range = arguments.max_range;
@@ -296,6 +319,49 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
     report.agreement =
         mvog_bench::compareMaps(points, mvog->map, options.occupancy_threshold, *octomap->tree);
   }
+  if (truth != nullptr) {
+    const mvog_bench::TruthLabels labels =
+        mvog_bench::labelPoints(truth->scene, input, truth->coverage, resolution);
+    // Each map's scores, and its panel of the slice when asked (the checks and every-reading
+    // have none).
+    auto score = [&](const char* backend, const auto& state_of, bool in_slice) {
+      report.truth.push_back({backend, mvog_bench::scoreMap(labels, state_of)});
+      if (in_slice && !arguments.truth_slice.empty()) {
+        truth->slice_panels.push_back(
+            mvog_bench::slicePanel(truth->scene.slice, resolution, state_of));
+      }
+    };
+    score(
+        "oracle",
+        [&](const Eigen::Vector3d& p) {
+          return mvog_bench::oracleState(truth->scene, truth->coverage, p);
+        },
+        false);
+    const mvog_bench::EndpointsMap endpoints(input, options.max_range, resolution);
+    score(
+        "endpoints-only", [&](const Eigen::Vector3d& p) { return endpoints.state(p); }, false);
+    const auto mvog_state = [&](const mvog::Map& map) {
+      return [&map, &options](const Eigen::Vector3d& p) {
+        return map.occupancy(p).state(options.occupancy_threshold);
+      };
+    };
+    if (mvog) score("mvog", mvog_state(mvog->map), true);
+    if (octomap) {
+      score(
+          "octomap",
+          [&](const Eigen::Vector3d& p) { return mvog_bench::octomapState(*octomap->tree, p); },
+          true);
+    }
+    if constexpr (mvog_bench::kBonxaiBuilt) {  // bonxaiState is defined only then
+      if (bonxai) {
+        score(
+            "bonxai",
+            [&](const Eigen::Vector3d& p) { return mvog_bench::bonxaiState(*bonxai->map, p); },
+            true);
+      }
+    }
+    if (every_reading) score("every-reading", mvog_state(every_reading->map), false);
+  }
   if (octomap) {  // last: writeBinary turns the tree into its maximum-likelihood estimate
     octomap->stats.binary_file_bytes = mvog_bench::octomapBinaryFileBytes(*octomap->tree);
     report.octomap = octomap->stats;
@@ -337,8 +403,20 @@ int main(int argc, char** argv) {
     sampling.max_range = arguments.max_range;
     const mvog_bench::SamplePoints points =
         mvog_bench::samplePoints(input, sampling, kAgreementRays);
+    std::optional<TruthContext> truth;
+    if (input.format == "truth") {
+      truth.emplace(TruthContext{
+          mvog_bench::truthScene(arguments.input.substr(mvog_bench::kTruthPrefix.size())),
+          mvog_bench::RayCoverage(input, arguments.max_range, mvog_bench::kCoverageVoxel),
+          {}});
+    }
     for (double resolution : arguments.resolutions) {
-      report.resolutions.push_back(benchmarkResolution(arguments, input, points, resolution));
+      report.resolutions.push_back(
+          benchmarkResolution(arguments, input, points, resolution, truth ? &*truth : nullptr));
+    }
+    if (!arguments.truth_slice.empty()) {
+      mvog_bench::writeTruthSlice(truth->scene, truth->coverage, truth->slice_panels,
+                                  arguments.truth_slice);
     }
     mvog_bench::printReport(report, input, stdout);
     if (!arguments.json.empty()) mvog_bench::writeJson(report, input, arguments.json);

@@ -206,6 +206,36 @@ std::string rulesText(const mvog::ModelRules& rules) {
               : std::to_string(rules.out_of_range_free_length).substr(0, 5) + " m");
 }
 
+/// A map's scores at the labelled points: shares of the points in the state each label calls
+/// right (and the two errors a planner pays for), and the F1 of "occupied".
+JsonObject truthJson(double resolution, const TruthResult& result) {
+  const TruthScores& t = result.scores;
+  using mvog::OccupancyState;
+  JsonObject o;
+  o.add("backend", result.backend)
+      .add("resolution", resolution)
+      .add("surface_occupied", TruthScores::share(t.surface, OccupancyState::kOccupied))
+      .add("surface_free", TruthScores::share(t.surface, OccupancyState::kFree))
+      .add("thin_occupied", TruthScores::share(t.thin, OccupancyState::kOccupied))
+      .add("free_near_surface_free", TruthScores::share(t.free_near_surface, OccupancyState::kFree))
+      .add("free_near_surface_occupied",
+           TruthScores::share(t.free_near_surface, OccupancyState::kOccupied))
+      .add("free_far_free", TruthScores::share(t.free_far_from_surfaces, OccupancyState::kFree))
+      .add("free_under_overhang_free",
+           TruthScores::share(t.free_under_overhang, OccupancyState::kFree))
+      .add("free_under_overhang_occupied",
+           TruthScores::share(t.free_under_overhang, OccupancyState::kOccupied))
+      .add("unobserved_unknown", TruthScores::share(t.unobserved, OccupancyState::kUnknown))
+      .add("occupancy_f1", t.occupancyF1())
+      .add("surface_points", t.surface.points())
+      .add("thin_points", t.thin.points())
+      .add("free_near_surface_points", t.free_near_surface.points())
+      .add("free_far_points", t.free_far_from_surfaces.points())
+      .add("free_under_overhang_points", t.free_under_overhang.points())
+      .add("unobserved_points", t.unobserved.points());
+  return o;
+}
+
 }  // namespace
 
 void printReport(const BenchReport& report, const InputData& input, std::FILE* out) {
@@ -287,6 +317,45 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
                    q.along_rays.percent(mvog::OccupancyState::kFree),
                    q.far_from_data.percent(mvog::OccupancyState::kUnknown), q.endpoints.points(),
                    q.far_from_data.points());
+    }
+  }
+
+  bool truth_header = false;
+  for (const ResolutionReport& r : report.resolutions) {
+    for (const TruthResult& result : r.truth) {
+      using mvog::OccupancyState;
+      const TruthScores& t = result.scores;
+      if (!truth_header) {
+        std::fprintf(out,
+                     "\nGround truth (shares of the labelled points; oracle and endpoints-only "
+                     "check the labels): surface called occupied, called free; thin objects "
+                     "occupied; free space called free near surfaces (occupied), far from them, "
+                     "under overhangs (occupied); unobserved called unknown; F1 of occupied\n"
+                     "%-13s %7s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n",
+                     "backend", "res (m)", "surf occ", "surf fr", "thin occ", "near fr", "near occ",
+                     "far fr", "under fr", "under oc", "unobs un", "F1");
+        truth_header = true;
+      }
+      std::fprintf(out, "%-13s %7.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f\n",
+                   result.backend.c_str(), r.resolution,
+                   TruthScores::share(t.surface, OccupancyState::kOccupied),
+                   TruthScores::share(t.surface, OccupancyState::kFree),
+                   TruthScores::share(t.thin, OccupancyState::kOccupied),
+                   TruthScores::share(t.free_near_surface, OccupancyState::kFree),
+                   TruthScores::share(t.free_near_surface, OccupancyState::kOccupied),
+                   TruthScores::share(t.free_far_from_surfaces, OccupancyState::kFree),
+                   TruthScores::share(t.free_under_overhang, OccupancyState::kFree),
+                   TruthScores::share(t.free_under_overhang, OccupancyState::kOccupied),
+                   TruthScores::share(t.unobserved, OccupancyState::kUnknown), t.occupancyF1());
+    }
+    if (!r.truth.empty()) {
+      const TruthScores& t = r.truth.front().scores;
+      std::fprintf(out,
+                   "%-13s %7.3f labelled points: %zu surface (%zu thin), %zu free near surfaces, "
+                   "%zu far, %zu under overhangs, %zu unobserved\n",
+                   "", r.resolution, t.surface.points(), t.thin.points(),
+                   t.free_near_surface.points(), t.free_far_from_surfaces.points(),
+                   t.free_under_overhang.points(), t.unobserved.points());
     }
   }
 
@@ -373,7 +442,7 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
 void writeJson(const BenchReport& report, const InputData& input, const std::string& path) {
   const std::size_t readings = input.readings();
   std::vector<JsonObject> results, table_one, comparison, agreement, quality, bonxai_comparison,
-      every_reading_agreement;
+      every_reading_agreement, truth;
   for (const ResolutionReport& r : report.resolutions) {
     if (r.mvog) results.push_back(mvogJson("mvog", r.resolution, readings, *r.mvog));
     if (r.octomap) results.push_back(octomapJson(r.resolution, readings, *r.octomap));
@@ -412,6 +481,7 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
           .add("far_points", (*q)->far_from_data.points());
       quality.push_back(row);
     }
+    for (const TruthResult& result : r.truth) truth.push_back(truthJson(r.resolution, result));
     JsonObject row;
     row.add("resolution", r.resolution)
         .add("point_cloud_bytes", readings * kPointCloudBytesPerPoint)
@@ -473,7 +543,8 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
       .add("comparison", comparison)
       .add("agreement", agreement)
       .add("bonxai_comparison", bonxai_comparison)
-      .add("every_reading_agreement", every_reading_agreement);
+      .add("every_reading_agreement", every_reading_agreement)
+      .add("truth", truth);
 
   const std::string temporary = path + ".tmp." + std::to_string(::getpid());
   {

@@ -8,8 +8,16 @@
 #include "backends.h"
 #include "bonxai_backend.h"
 #include "input.h"
+#include "truth.h"
 
 namespace mvog_bench {
+
+/// One map's scores at a ground-truth scene's labelled points (`backend`: a backend, or the
+/// labels' checks "oracle" and "endpoints-only").
+struct TruthResult {
+  std::string backend;
+  TruthScores scores;
+};
 
 /// Everything measured at one resolution; a backend not run is empty.
 struct ResolutionReport {
@@ -27,6 +35,8 @@ struct ResolutionReport {
   /// it when MVOG ran too.
   std::optional<MvogStats> every_reading;
   std::optional<EveryReadingAgreement> every_reading_agreement;
+  /// On a ground-truth scene (truth:NAME): the two checks, then each backend run.
+  std::vector<TruthResult> truth;
 };
 
 struct BenchReport {
@@ -41,13 +51,13 @@ struct BenchReport {
 };
 
 /// The readable tables: per backend and resolution, Table I, MVOG / OctoMap ratios, agreement,
-/// MVOG / Bonxai ratios.
+/// MVOG / Bonxai ratios, the ground truth.
 void printReport(const BenchReport& report, const InputData& input, std::FILE* out);
 
 /// {"results": [{"backend", "resolution", "readings", "insert_seconds", "readings_per_second",
 /// "memory_bytes", "file_bytes", ...}, ...], "input": {...}, "table_one": [...],
-/// "comparison": [...], "agreement": [...], "bonxai_comparison": [...]}, written atomically
-/// (temporary file, then rename). Throws std::runtime_error if it cannot be written.
+/// "comparison": [...], "agreement": [...], "bonxai_comparison": [...], "truth": [...]}, written
+/// atomically (temporary file, then rename). Throws std::runtime_error if it cannot be written.
 void writeJson(const BenchReport& report, const InputData& input, const std::string& path);
 
 }  // namespace mvog_bench

@@ -79,16 +79,7 @@ InputData loadSynthetic(const std::string& name) {
     throw InputError(std::string(kSyntheticPrefix) + name +
                      ": no such synthetic input (there are " + names + ")");
   }
-  InputData input;
-  input.format = "synthetic";
-  for (mvog::Scan& scan : sensor->second()) {
-    ++input.sensor_messages;
-    input.out_of_range_readings += scan.out_of_range.size();
-    input.out_of_range.push_back(std::move(scan.out_of_range));
-    scan.out_of_range.clear();
-    input.scans.push_back(std::move(scan));
-  }
-  return input;
+  return inputOfScans("synthetic", sensor->second());
 }
 
 }  // namespace mvog_bench
