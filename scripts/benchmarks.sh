@@ -8,7 +8,8 @@
 # instruction counts of the three insertions (callgrind: the ratios the machine's load cannot
 # disturb); writes the outputs (JSON and text) to OUT and prints the report's tables
 # (scripts/benchmark_tables.py).
-#   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~40 min here)
+#   scripts/benchmarks.sh [OUT]    (default OUT: the workspace's benchmarks/; ~15 min here
+#                                  after the build)
 # MVOG_BENCH_REPEAT (default 3): insertions per backend, the fastest reported.
 # shellcheck source=scripts/common.sh
 source "$(dirname "$0")/common.sh"

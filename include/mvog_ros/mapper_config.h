@@ -38,9 +38,9 @@ struct SensorInputsConfig {
 /// The model's rules are the map's (MapperConfig::map: ~model, ~clip_free_space_at_hits, ...).
 struct InsertionWorkerConfig : mvog::InsertionConfig {
   int insertion_queue_size = 3;  // converted messages waiting to be inserted
-  // Threads per insertion while another message waits behind it, if more than
-  // insertion_threads (the map is the same for any count): a sensor that outpaces one core gets
-  // both of a 2-core robot's.
+  // Threads per insertion of a scan of 10,000 readings or more while another message waits
+  // behind it, if more than insertion_threads (the map is the same for any count): a sensor that
+  // outpaces one core gets both of a 2-core robot's.
   int backlog_insertion_threads = 2;
 
   void validate() const;

@@ -493,6 +493,7 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
   cells_in.assign(kSectors, 0.0);
   const bool origin_accepted = map_config.withinBounds(scan.origin);
   const bool by_end_voxel = walksOneRayPerEndVoxel(map_config, insertion);
+  std::optional<EndVoxel> previous_voxel;  // of the reading before, by_end_voxel
   for (std::size_t k = 0; k < num_readings; ++k) {
     const bool is_hit = k < num_hits;
     const Eigen::Vector3d end =
@@ -508,14 +509,18 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
     const double free_length = freeLengthOf(
         is_hit ? ReadingKind::kObstacle : ReadingKind::kOutOfRange, map_config, insertion);
     // The walk takes |di| + |dj| steps over the part of the ray it frees: the cells it costs.
-    const double walk_cells =
+    double walk_cells =
         (std::fabs(ray.x()) + std::fabs(ray.y())) * std::min(1.0, free_length / length) * s + 1.0;
     Eigen::Vector2d direction = ray.head<2>();
     if (by_end_voxel) {
       // The readings of an end voxel go to the one chunk that walks its ray (EndVoxelRays): by
-      // the direction of the voxel's centre.
+      // the direction of the voxel's centre. A reading ending in the voxel of the one before (a
+      // depth image's neighbouring pixel, mostly) adds no walk of its own, only about a cell's
+      // cost of grouping: so the chunks share the walks, not the readings.
       const EndVoxel voxel = endVoxelOf(freeEnd(scan.origin, end, length, free_length) * s, false);
       direction = Eigen::Vector2d(voxel.x + 0.5, voxel.y + 0.5) - scan.origin.head<2>() * s;
+      if (previous_voxel && *previous_voxel == voxel) walk_cells = 1.0;
+      previous_voxel = voxel;
     }
     // A vertical ray has no direction in xy: it crosses one column, in sector 0.
     const bool vertical = direction.x() == 0.0 && direction.y() == 0.0;

@@ -9,6 +9,14 @@
 #include <ros/console.h>
 
 namespace mvog_ros {
+namespace {
+
+/// The fewest readings for which a scan goes in on ~backlog_insertion_threads: a smaller one (a
+/// 2D laser's few hundred) is inserted in well under a millisecond, about what handing its parts
+/// to other threads and waiting for them costs, and a bag replayed fast sends many such scans.
+constexpr std::size_t kMinReadingsForBacklogThreads = 10000;
+
+}  // namespace
 
 InsertionWorker::InsertionWorker(const InsertionWorkerConfig& config, SharedMap& shared_map)
     : config_(config), map_(shared_map), thread_(&InsertionWorker::run, this) {}
@@ -43,14 +51,15 @@ void InsertionWorker::stop() {
 void InsertionWorker::run() {
   for (;;) {
     QueuedScan queued;
-    bool backlog = false;  // another message waits behind this one
+    bool backlog = false;  // another message waits behind this one, and it is large
     {
       std::unique_lock<std::mutex> lock(queue_mutex_);
       queue_changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
       if (queue_.empty()) return;  // stopping, and what was queued is in the map
       queued = std::move(queue_.front());
       queue_.pop_front();
-      backlog = !queue_.empty();
+      backlog = !queue_.empty() && queued.scan.hits.size() + queued.scan.out_of_range.size() >=
+                                       kMinReadingsForBacklogThreads;
     }
     const auto start = std::chrono::steady_clock::now();
     const mvog::InsertionResult result = insert(queued.scan, backlog);

@@ -332,7 +332,7 @@ TEST_F(BenchSmokeTest, WithoutBonxaiSaysWhyAndAllRunsTheOthers) {
             std::string::npos)
       << errors;
   const Json::Value root = readJson(json);
-  EXPECT_EQ(root["results"].size(), 3u);  // mvog, octomap and the walk
+  EXPECT_EQ(root["results"].size(), 4u);  // mvog, octomap, the walk and every reading's walk
   EXPECT_EQ(root["bonxai_comparison"].size(), 0u);
 }
 #endif

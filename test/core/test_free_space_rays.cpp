@@ -83,10 +83,6 @@ InsertionResult insertIntoNewMap(const Scan& scan, const InsertionConfig& insert
   return map.insertScan(scan, insertion);
 }
 
-OccupancyState stateAt(const Map& map, const Eigen::Vector3d& point) {
-  return map.occupancy(point).state(kDefaultOccupancyThreshold);
-}
-
 // ---- Agreement with every reading's walk ------------------------------------------------------
 
 /// Points at which a map is compared with every reading's walk, by kind, of the same kinds as
@@ -138,7 +134,8 @@ struct Agreement {
 Agreement agreementAt(const std::vector<Eigen::Vector3d>& points, const Map& a, const Map& b) {
   Agreement agreement;
   agreement.points = points.size();
-  for (const Eigen::Vector3d& p : points) agreement.same += stateAt(a, p) == stateAt(b, p);
+  for (const Eigen::Vector3d& p : points)
+    agreement.same += test::stateAt(a, p) == test::stateAt(b, p);
   return agreement;
 }
 
@@ -335,8 +332,8 @@ TEST(FreeSpaceRays, OneScanOnAnEmptyMapFreesASubsetOfWhatEveryReadingFrees) {
       EXPECT_LT(result.rays_walked, result.inserted() / 5);
       std::size_t free_with_every_reading_only = 0;
       for (const Eigen::Vector3d& point : pointsAround(scan, rng)) {
-        const OccupancyState one = stateAt(one_ray, point);
-        const OccupancyState every = stateAt(every_reading, point);
+        const OccupancyState one = test::stateAt(one_ray, point);
+        const OccupancyState every = test::stateAt(every_reading, point);
         EXPECT_EQ(one == OccupancyState::kOccupied, every == OccupancyState::kOccupied)
             << point.transpose();
         if (one == OccupancyState::kFree) {
@@ -404,7 +401,7 @@ TEST(FreeSpaceRays, TheMapDependsNeitherOnTheReadingsOrderNorOnTheThreads) {
 // ---- A depth camera ---------------------------------------------------------------------------
 
 /// A 640 x 480 camera at (0, 0, 1) looking along the map's +x.
-const PinholeCamera kCamera{525.0, 525.0, 319.5, 239.5};
+const PinholeCamera kKinectCamera{525.0, 525.0, 319.5, 239.5};
 constexpr std::uint32_t kWidth = 640;
 constexpr std::uint32_t kHeight = 480;
 
@@ -427,8 +424,8 @@ struct SceneHit {
 /// Where the ray of pixel (u, v) meets the scene. Its direction in the map, (1, dy, dz), has
 /// depth 1 along the optical axis, so the distance along it is the depth.
 SceneHit castRay(std::uint32_t u, std::uint32_t v) {
-  const double dy = -(u - kCamera.cx) / kCamera.fx;
-  const double dz = -(v - kCamera.cy) / kCamera.fy;
+  const double dy = -(u - kKinectCamera.cx) / kKinectCamera.fx;
+  const double dz = -(v - kKinectCamera.cy) / kKinectCamera.fy;
   SceneHit hit{dy > 0.0 ? 1.0 : 4.0, false};
   // (t - 3)^2 + (dy t + 0.3)^2 = 0.01^2, the nearer root.
   const double a = 1.0 + dy * dy;
@@ -474,7 +471,7 @@ TEST(FreeSpaceRays, ADepthCameraKeepsEveryHitAndFreesItsRaysWithAFifthOfTheWalks
   // with every reading's walk at the hits, along the rays and near the hits.
   const SceneImage image;
   std::size_t skipped = 0;
-  const Scan scan = backProjectDepthImage(image.view(), kCamera, cameraPose(), {}, skipped);
+  const Scan scan = backProjectDepthImage(image.view(), kKinectCamera, cameraPose(), {}, skipped);
   ASSERT_EQ(skipped, 0u);
   ASSERT_EQ(scan.hits.size(), std::size_t{kWidth} * kHeight);
   Map one_ray(mapConfig(0.05));
@@ -489,11 +486,11 @@ TEST(FreeSpaceRays, ADepthCameraKeepsEveryHitAndFreesItsRaysWithAFifthOfTheWalks
   std::size_t free_midpoints = 0;
   for (std::size_t k = 0; k < scan.hits.size(); ++k) {
     const Eigen::Vector3d hit = scan.hits[k].cast<double>();
-    const bool occupied = stateAt(one_ray, hit) == OccupancyState::kOccupied;
+    const bool occupied = test::stateAt(one_ray, hit) == OccupancyState::kOccupied;
     occupied_hits += occupied;
     pole_pixels += image.pole[k];
     occupied_pole_pixels += image.pole[k] && occupied;
-    free_midpoints += stateAt(one_ray, 0.5 * (scan.origin + hit)) == OccupancyState::kFree;
+    free_midpoints += test::stateAt(one_ray, 0.5 * (scan.origin + hit)) == OccupancyState::kFree;
   }
   EXPECT_EQ(occupied_hits, scan.hits.size());
   EXPECT_GT(pole_pixels, 1000u);

@@ -32,15 +32,11 @@ namespace {
 
 using test::kInf;
 
-OccupancyState stateAt(const Map& map, const Eigen::Vector3d& point) {
-  return map.occupancy(point).state(kDefaultOccupancyThreshold);
-}
-
 /// The state at `point` if it stays the same when the point moves up or down by 1e-4 of a cell.
 std::optional<OccupancyState> robustStateAt(const Map& map, const Eigen::Vector3d& point) {
   const Eigen::Vector3d nudge(0.0, 0.0, 1e-4 * map.resolution());
-  const OccupancyState state = stateAt(map, point);
-  if (stateAt(map, point + nudge) != state || stateAt(map, point - nudge) != state) {
+  const OccupancyState state = test::stateAt(map, point);
+  if (test::stateAt(map, point + nudge) != state || test::stateAt(map, point - nudge) != state) {
     return std::nullopt;
   }
   return state;
@@ -62,7 +58,8 @@ Sampled sample(const Map& map, const Segment& segment, double step, double from,
         length > 0.0
             ? Eigen::Vector3d(segment.start + (segment.end - segment.start) * (at / length))
             : segment.start;
-    std::optional<OccupancyState> state = robust ? robustStateAt(map, point) : stateAt(map, point);
+    std::optional<OccupancyState> state =
+        robust ? robustStateAt(map, point) : test::stateAt(map, point);
     if (state && *state != OccupancyState::kFree) {
       result.first_blocked = std::min(result.first_blocked, at);
       result.occupied |= *state == OccupancyState::kOccupied;

@@ -56,6 +56,11 @@ inline MapConfig unitConfig(double max_coordinate = 10000.0,
   return config;
 }
 
+/// The state eq. (9) gives at `point` with the default threshold.
+inline OccupancyState stateAt(const Map& map, const Eigen::Vector3d& point) {
+  return map.occupancy(point).state(kDefaultOccupancyThreshold);
+}
+
 /// Tolerance for heights and masses computed by hand in double from numbers stored as floats.
 constexpr double kTolerance = 1e-5;
 

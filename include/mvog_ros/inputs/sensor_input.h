@@ -113,9 +113,12 @@ class SensorInput {
   /// Retries the waiting messages (timer): transforms arrive on tf's own thread.
   void retryWaitingMessages(const ros::TimerEvent&);
   void dropForTransform(const std_msgs::Header& header, const std::string& why);
-  /// Drops a message that cannot be converted, counted, with a throttled warning.
+  /// Drops a message that cannot be converted, counted, with a warning throttled per input (one
+  /// input's bad messages do not hide another's).
   void rejectMessage(const std::string& message_type, const std::string& why);
 
+  /// Wall time (s) of this input's last warning of an invalid message.
+  std::atomic<double> last_invalid_warning_{-kWarningPeriod};
   std::mutex mutex_;
   std::deque<WaitingMessage> waiting_;  // oldest first
   ros::Subscriber subscriber_;

@@ -85,10 +85,14 @@ void SensorInput::dropForTransform(const std_msgs::Header& header, const std::st
 
 void SensorInput::rejectMessage(const std::string& message_type, const std::string& why) {
   ++context_.counters.messages_dropped_invalid;
-  ROS_WARN_THROTTLE(
-      kWarningPeriod, "mvog: dropped an invalid %s: %s (%llu invalid so far)", message_type.c_str(),
-      why.c_str(),
-      static_cast<unsigned long long>(context_.counters.messages_dropped_invalid.load()));
+  const double now = ros::WallTime::now().toSec();
+  double last = last_invalid_warning_.load();
+  if (now - last < kWarningPeriod || !last_invalid_warning_.compare_exchange_strong(last, now)) {
+    return;  // warned within the period (or another thread warns now)
+  }
+  ROS_WARN("mvog: dropped an invalid %s: %s (%llu invalid so far)", message_type.c_str(),
+           why.c_str(),
+           static_cast<unsigned long long>(context_.counters.messages_dropped_invalid.load()));
 }
 
 }  // namespace mvog_ros
