@@ -480,6 +480,7 @@ struct ReadingSplit {
   std::vector<std::uint8_t> chunk_of_reading;    ///< by reading: hits, then out-of-range ones
   std::vector<std::uint16_t> sector_of_reading;  ///< the direction of its ray
   std::vector<double> cells_in_sector;           ///< the cell visits of the sector's readings
+  std::vector<double> cells_in_part;  ///< the same by run of readings (a thread's), then sector
 };
 /// Whether a scan's free space is walked one ray per end voxel (FreeSpaceRays).
 inline bool walksOneRayPerEndVoxel(const MapConfig& map_config, const InsertionConfig& insertion) {
@@ -487,9 +488,10 @@ inline bool walksOneRayPerEndVoxel(const MapConfig& map_config, const InsertionC
          insertion.free_space_rays == FreeSpaceRays::kOnePerEndVoxel &&
          insertion.model_negative_space;
 }
-/// Splits a scan's readings among `chunks` threads (see scan_update.cpp).
+/// Splits a scan's readings among `chunks` threads (see scan_update.cpp), reading them on
+/// `pool`'s threads if not null.
 void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
-                           const InsertionConfig& insertion, std::size_t chunks,
+                           const InsertionConfig& insertion, std::size_t chunks, ThreadPool* pool,
                            ReadingSplit& split);
 /// The gap under which one scan's intervals join (see ScanInterval).
 inline float joinGapOf(const ModelRules& rules) {

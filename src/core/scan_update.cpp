@@ -482,54 +482,73 @@ float pseudoAngle(double dx, double dy) {
 /// parts joined when the scan is applied (which the map's result does not depend on: it is the
 /// same for any split, ScanInterval).
 void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
-                           const InsertionConfig& insertion, std::size_t chunks,
+                           const InsertionConfig& insertion, std::size_t chunks, ThreadPool* pool,
                            ReadingSplit& split) {
   const std::size_t num_hits = scan.hits.size();
   const std::size_t num_readings = num_hits + scan.out_of_range.size();
   const double s = 1.0 / map_config.resolution;
   std::vector<std::uint16_t>& sector_of = split.sector_of_reading;
-  std::vector<double>& cells_in = split.cells_in_sector;
-  sector_of.assign(num_readings, 0);
-  cells_in.assign(kSectors, 0.0);
+  sector_of.resize(num_readings);
+  // The readings are read in `parts` runs of consecutive readings, one a thread, each counting
+  // the cells of its sectors in its own row of split.cells_in_part.
+  const std::size_t parts = pool != nullptr ? pool->threads() : 1;
+  split.cells_in_part.assign(parts * kSectors, 0.0);
   const bool origin_accepted = map_config.withinBounds(scan.origin);
   const bool by_end_voxel = walksOneRayPerEndVoxel(map_config, insertion);
-  std::optional<EndVoxel> previous_voxel;  // of the reading before, by_end_voxel
-  for (std::size_t k = 0; k < num_readings; ++k) {
-    const bool is_hit = k < num_hits;
-    const Eigen::Vector3d end =
-        (is_hit ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>();
-    const Eigen::Vector3d ray = end - scan.origin;
-    const double length = ray.norm();
-    // A reading that will be refused (acceptReading: not finite, beyond max_coordinate, at the
-    // origin) costs about one cell.
-    if (!origin_accepted || !map_config.withinBounds(end) || length == 0.0) {
-      cells_in[0] += 1.0;
-      continue;
+  auto sectors_of_part = [&](std::size_t, std::size_t part) {
+    double* cells_in = split.cells_in_part.data() + part * kSectors;
+    std::optional<EndVoxel> previous_voxel;  // of the reading before, by_end_voxel
+    for (std::size_t k = num_readings * part / parts; k < num_readings * (part + 1) / parts; ++k) {
+      const bool is_hit = k < num_hits;
+      const Eigen::Vector3d end =
+          (is_hit ? scan.hits[k] : scan.out_of_range[k - num_hits]).cast<double>();
+      const Eigen::Vector3d ray = end - scan.origin;
+      const double length = ray.norm();
+      // A reading that will be refused (acceptReading: not finite, beyond max_coordinate, at the
+      // origin) costs about one cell.
+      if (!origin_accepted || !map_config.withinBounds(end) || length == 0.0) {
+        cells_in[0] += 1.0;
+        sector_of[k] = 0;
+        continue;
+      }
+      const double free_length = freeLengthOf(
+          is_hit ? ReadingKind::kObstacle : ReadingKind::kOutOfRange, map_config, insertion);
+      // The walk takes |di| + |dj| steps over the part of the ray it frees: the cells it costs.
+      double walk_cells =
+          (std::fabs(ray.x()) + std::fabs(ray.y())) * std::min(1.0, free_length / length) * s + 1.0;
+      Eigen::Vector2d direction = ray.head<2>();
+      if (by_end_voxel) {
+        // The readings of an end voxel go to the one chunk that walks its ray (EndVoxelRays): by
+        // the direction of the voxel's centre. A reading ending in the voxel of the one before (a
+        // depth image's neighbouring pixel, mostly) adds no walk of its own, only about a cell's
+        // cost of grouping: so the chunks share the walks, not the readings.
+        const EndVoxel voxel =
+            endVoxelOf(freeEnd(scan.origin, end, length, free_length) * s, false);
+        direction = Eigen::Vector2d(voxel.x + 0.5, voxel.y + 0.5) - scan.origin.head<2>() * s;
+        if (previous_voxel && *previous_voxel == voxel) walk_cells = 1.0;
+        previous_voxel = voxel;
+      }
+      // A vertical ray has no direction in xy: it crosses one column, in sector 0.
+      const bool vertical = direction.x() == 0.0 && direction.y() == 0.0;
+      const auto sector = static_cast<std::uint16_t>(
+          vertical ? 0.0
+                   : std::min<double>(kSectors - 1, pseudoAngle(direction.x(), direction.y()) *
+                                                        (kSectors / 4.0)));
+      sector_of[k] = sector;
+      cells_in[sector] += walk_cells;
     }
-    const double free_length = freeLengthOf(
-        is_hit ? ReadingKind::kObstacle : ReadingKind::kOutOfRange, map_config, insertion);
-    // The walk takes |di| + |dj| steps over the part of the ray it frees: the cells it costs.
-    double walk_cells =
-        (std::fabs(ray.x()) + std::fabs(ray.y())) * std::min(1.0, free_length / length) * s + 1.0;
-    Eigen::Vector2d direction = ray.head<2>();
-    if (by_end_voxel) {
-      // The readings of an end voxel go to the one chunk that walks its ray (EndVoxelRays): by
-      // the direction of the voxel's centre. A reading ending in the voxel of the one before (a
-      // depth image's neighbouring pixel, mostly) adds no walk of its own, only about a cell's
-      // cost of grouping: so the chunks share the walks, not the readings.
-      const EndVoxel voxel = endVoxelOf(freeEnd(scan.origin, end, length, free_length) * s, false);
-      direction = Eigen::Vector2d(voxel.x + 0.5, voxel.y + 0.5) - scan.origin.head<2>() * s;
-      if (previous_voxel && *previous_voxel == voxel) walk_cells = 1.0;
-      previous_voxel = voxel;
+  };
+  if (pool != nullptr) {
+    pool->run(parts, sectors_of_part);
+  } else {
+    sectors_of_part(0, 0);
+  }
+  std::vector<double>& cells_in = split.cells_in_sector;
+  cells_in.assign(split.cells_in_part.begin(), split.cells_in_part.begin() + kSectors);
+  for (std::size_t part = 1; part < parts; ++part) {
+    for (std::size_t sector = 0; sector < kSectors; ++sector) {
+      cells_in[sector] += split.cells_in_part[part * kSectors + sector];
     }
-    // A vertical ray has no direction in xy: it crosses one column, in sector 0.
-    const bool vertical = direction.x() == 0.0 && direction.y() == 0.0;
-    const auto sector = static_cast<std::uint16_t>(
-        vertical ? 0.0
-                 : std::min<double>(kSectors - 1,
-                                    pseudoAngle(direction.x(), direction.y()) * (kSectors / 4.0)));
-    sector_of[k] = sector;
-    cells_in[sector] += walk_cells;
   }
   // Around the circle from the sector with the fewest cells (outside a camera's field of view,
   // or a 360-degree sensor's emptiest direction), each chunk takes consecutive sectors until it
@@ -607,7 +626,8 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
   const double s = 1.0 / map_config.resolution;
   std::vector<InsertionResult> results(num_threads);
   if (num_threads > 1) {
-    detail::splitReadingsBySector(scan, map_config, insertion, num_threads, impl.split);
+    detail::splitReadingsBySector(scan, map_config, insertion, num_threads,
+                                  impl.threads(num_threads), impl.split);
   }
   // The readings of chunk k (split.chunk_of_reading) go to scratch k.
   auto rasterize = [&](std::size_t, std::size_t chunk) {
