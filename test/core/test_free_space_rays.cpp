@@ -379,21 +379,28 @@ Scan shuffledReadings(Scan scan) {
 TEST(FreeSpaceRays, TheMapDependsNeitherOnTheReadingsOrderNorOnTheThreads) {
   // Threads share a scan's readings by direction; the voxels of a scan all around its origin lie
   // across every boundary between their sectors. Shuffled readings, and 1 to 4 threads: the
-  // same volumes bit for bit, and the same rays walked.
+  // same volumes bit for bit, and the same rays walked; also with the hits beyond 2.6 m truncated
+  // to max_range (their voxels then lie on a sphere, free space only).
   const Scan scan = surroundingScan();
-  Map reference(mapConfig());
-  const InsertionResult walked = reference.insertScan(scan);
-  EXPECT_LT(walked.rays_walked, walked.inserted() / 5);
   const Scan shuffled = shuffledReadings(scan);
-  for (int threads = 1; threads <= 4; ++threads) {
-    for (const Scan* readings : {&scan, &shuffled}) {
-      SCOPED_TRACE(std::to_string(threads) + " threads" +
-                   (readings == &shuffled ? ", shuffled" : ""));
-      InsertionConfig insertion;
-      insertion.insertion_threads = threads;
-      Map map(mapConfig());
-      EXPECT_EQ(map.insertScan(*readings, insertion).rays_walked, walked.rays_walked);
-      EXPECT_TRUE(test::sameVolumes(allVolumes(map), allVolumes(reference)));
+  for (const double max_range : {test::kInf, 2.6}) {
+    SCOPED_TRACE("max_range " + std::to_string(max_range));
+    InsertionConfig one_thread;
+    one_thread.max_range = max_range;
+    Map reference(mapConfig());
+    const InsertionResult walked = reference.insertScan(scan, one_thread);
+    EXPECT_LT(walked.rays_walked, walked.inserted() / 5);
+    EXPECT_EQ(walked.truncated_to_max_range > 0, max_range < test::kInf);
+    for (int threads = 1; threads <= 4; ++threads) {
+      for (const Scan* readings : {&scan, &shuffled}) {
+        SCOPED_TRACE(std::to_string(threads) + " threads" +
+                     (readings == &shuffled ? ", shuffled" : ""));
+        InsertionConfig insertion = one_thread;
+        insertion.insertion_threads = threads;
+        Map map(mapConfig());
+        EXPECT_EQ(map.insertScan(*readings, insertion).rays_walked, walked.rays_walked);
+        EXPECT_TRUE(test::sameVolumes(allVolumes(map), allVolumes(reference)));
+      }
     }
   }
 }
