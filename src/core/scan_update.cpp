@@ -427,9 +427,11 @@ void rasterizeReadings(const Scan& scan, const Mine& mine, const MapConfig& map_
     } else if (end_voxels == nullptr) {
       addReading(start, end_cells, obstacle, true, writer);
       ++result.rays_walked;
-    } else {  // the voxel's hits and its rays once all its readings are offered
+    } else if (obstacle) {  // the voxel's hits and its rays once all its readings are offered
       const Volume hit = hitVolume(static_cast<float>(end_cells.z()));
-      end_voxels->offer(end_cells, obstacle ? &hit : nullptr);
+      end_voxels->offer(end_cells, &hit);
+    } else {
+      end_voxels->offer(end_cells, nullptr);
     }
   };
   // The rays of the end voxels whose readings ended in an obstacle, or not.
