@@ -158,6 +158,34 @@ TEST_F(BenchSmokeTest, ReadsEveryNodeOfAGraphItWrote) {
   EXPECT_EQ(root["repeat"].asInt(), 2);
 }
 
+// --octomap-clamping off: OctoMap's every update counts. A voxel that ten scans' rays cross,
+// then three scans hit, is occupied with OctoMap's default clamping (its log-odds stop at
+// logodds(0.1192), about five misses, so three hits outweigh them) and free without it (ten
+// misses of 0.405 outweigh three hits of 0.847), as MVOG's summed masses weigh them.
+TEST_F(BenchSmokeTest, OctomapWithoutClampingCountsEveryUpdate) {
+  std::vector<std::vector<double>> nodes(10, {2.05, 0.05, 0.05});  // crossing (1.05, 0.05, 0.025)
+  nodes.resize(13, {1.05, 0.05, 0.05});                            // then hitting it
+  const std::string input = writeGraph("crossed_then_hit.graph", nodes);
+  auto endpoints_occupied = [&](const std::string& clamping) {
+    const std::string json = directory_ + "/" + clamping + ".json";
+    std::string errors;
+    EXPECT_EQ(runBench("--input '" + input + "' --resolution 0.1 --backend octomap " +
+                           "--octomap-clamping " + clamping + " --json '" + json + "'",
+                       errors),
+              0)
+        << errors;
+    const Json::Value root = readJson(json);
+    EXPECT_EQ(root["octomap_clamping"].asBool(), clamping == "on");
+    return root["quality"][0]["endpoints_occupied_percent"].asDouble();
+  };
+  EXPECT_EQ(endpoints_occupied("on"), 100.0);
+  EXPECT_NEAR(endpoints_occupied("off"), 100.0 * 10.0 / 13.0, 1e-6);  // JSON keeps 9 digits
+  std::string errors;
+  EXPECT_EQ(runBench("--input '" + input + "' --octomap-clamping maybe", errors), 2);
+  EXPECT_NE(errors.find("--octomap-clamping must be on or off, got 'maybe'"), std::string::npos)
+      << errors;
+}
+
 // Sensors none of the shared recordings has (a multi-beam automotive lidar, a tilting laser),
 // cast into scenes built in code: what each saw stays occupied as in OctoMap on the same rays,
 // within issue 10's margins (ends occupied >= OctoMap's - 2 points, along the rays free >=

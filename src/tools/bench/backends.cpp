@@ -86,6 +86,10 @@ OctomapRun runOctomap(const InputData& input, const RunOptions& options) {
   const double max_range = std::isfinite(options.max_range) ? options.max_range : -1.0;
   OctomapRun run;
   run.tree = std::make_unique<octomap::OcTree>(options.resolution);
+  if (!options.octomap_clamping) {  // logodds of 0 and 1: -inf and +inf, no bound
+    run.tree->setClampingThresMin(0.0);
+    run.tree->setClampingThresMax(1.0);
+  }
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < clouds.size(); ++k) {
     run.tree->insertPointCloud(clouds[k], toOctomap(input.scans[k].origin), max_range);

@@ -31,6 +31,9 @@ struct RunOptions {
   bool out_of_range = false;
   /// MVOG only: which rays are walked for free space (InsertionConfig::free_space_rays).
   mvog::FreeSpaceRays free_space_rays = mvog::InsertionConfig{}.free_space_rays;
+  /// OctoMap only: its log-odds clamped to [logodds(0.1192), logodds(0.971)] at each update (its
+  /// default), or not clamped at all (OcTree::setClampingThresMin(0), setClampingThresMax(1)).
+  bool octomap_clamping = true;
 };
 
 /// Seconds from `start` to now (steady clock): what each backend's insertion took.

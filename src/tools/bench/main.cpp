@@ -6,6 +6,7 @@
 //              [--model default|paper] [--clip-free-space-at-hits on|off]
 //              [--mass-counting per-scan|per-reading] [--split-free-space-at-obstacles on|off]
 //              [--free-space-rays one-per-end-voxel|every-reading]
+//              [--octomap-clamping on|off]
 //              [--truth-slice OUT.ppm]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
 #include <algorithm>
@@ -40,6 +41,7 @@ struct Arguments {
   std::optional<double> occupancy_threshold;
   bool out_of_range = false;  ///< default: the rules' (the paper's for --model paper)
   mvog::FreeSpaceRays free_space_rays = mvog::InsertionConfig{}.free_space_rays;
+  bool octomap_clamping = true;
   bool run_mvog = false;
   bool run_octomap = false;
   bool run_bonxai = false;
@@ -65,6 +67,7 @@ constexpr const char* kUsage =
     "                  [--split-free-space-at-obstacles on|off] [--occupancy-threshold T]\n"
     "                  [--out-of-range-free-length L|inf]\n"
     "                  [--free-space-rays one-per-end-voxel|every-reading]\n"
+    "                  [--octomap-clamping on|off]\n"
     "                  [--truth-slice OUT.ppm]\n"
     "  FILE        a ROS bag (LaserScan, PointCloud2 and/or depth Image 16UC1 or 32FC1 with\n"
     "              CameraInfo; poses from /tf and /tf_static)\n"
@@ -94,6 +97,8 @@ constexpr const char* kUsage =
     "              it change one rule each (mvog::ModelRules, README's decisions table)\n"
     "  --free-space-rays  MVOG walks one ray per end voxel (the default) or every reading's\n"
     "              (mvog::FreeSpaceRays)\n"
+    "  --octomap-clamping  OctoMap's log-odds clamped at each update (on, its default) or\n"
+    "              not (off: every hit and miss counts, as MVOG's masses do)\n"
     "  --truth-slice  with truth:NAME, a cross-section of the scene with each map's errors\n"
     "              coloured, as a binary PPM: a panel per resolution and map (mvog, octomap,\n"
     "              bonxai, those run), top to bottom\n";
@@ -187,6 +192,8 @@ Arguments parseArguments(int argc, char** argv) {
       }
       arguments.free_space_rays = value == "every-reading" ? mvog::FreeSpaceRays::kEveryReading
                                                            : mvog::FreeSpaceRays::kOnePerEndVoxel;
+    } else if (option == "--octomap-clamping") {
+      arguments.octomap_clamping = onOff(option, value);
     } else if (option == "--json") {
       arguments.json = value;
     } else if (option == "--fixed-frame") {
@@ -242,6 +249,7 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   options.occupancy_threshold = occupancyThreshold(arguments);
   options.out_of_range = arguments.out_of_range;
   options.free_space_rays = arguments.free_space_rays;
+  options.octomap_clamping = arguments.octomap_clamping;
   mvog_bench::ResolutionReport report;
   report.resolution = resolution;
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
@@ -390,6 +398,7 @@ int main(int argc, char** argv) {
     report.input_path = arguments.input;
     report.max_range = arguments.max_range;
     report.rules = arguments.rules;
+    report.octomap_clamping = arguments.octomap_clamping;
     report.occupancy_threshold = occupancyThreshold(arguments);
     report.out_of_range = arguments.out_of_range;
     report.repeat = arguments.repeat;

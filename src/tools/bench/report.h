@@ -45,8 +45,9 @@ struct BenchReport {
   double max_range = 0.0;  ///< infinity: none
   mvog::ModelRules rules;
   double occupancy_threshold = 0.0;
-  bool out_of_range = false;  ///< the out-of-range readings were given to MVOG
-  int repeat = 1;             ///< insertions per backend; the fastest is reported
+  bool octomap_clamping = true;  ///< RunOptions::octomap_clamping
+  bool out_of_range = false;     ///< the out-of-range readings were given to MVOG
+  int repeat = 1;                ///< insertions per backend; the fastest is reported
   std::vector<ResolutionReport> resolutions;
 };
 
