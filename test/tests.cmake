@@ -52,6 +52,7 @@ mvog_add_gtest(test_mvog_core
           test/core/test_checks.cpp test/core/test_segment_property.cpp
           test/core/test_frontiers.cpp test/core/test_surfaces.cpp
           test/core/test_depth_image.cpp test/core/test_free_space_rays.cpp
+          test/core/test_evidence_limit.cpp
           src/tools/bench/scan_graph_input.cpp
   LIBRARIES mvog_core)
 target_include_directories(test_mvog_core PRIVATE src/tools/bench)

@@ -91,6 +91,11 @@ struct MapConfig {
   void validate() const;
 };
 
+/// The default of InsertionConfig::evidence_limit (scans): OctoMap's clamping range counted in
+/// misses, (logit(0.971) - logit(0.1192)) / |logit(0.4)| = 13.6 with its defaults, the evidence
+/// an OctoMap voxel can hold between its two clamps.
+constexpr double kDefaultEvidenceLimit = 14.0;
+
 /// Which rays of a scan are walked for free space (Sec. III-B.1).
 enum class FreeSpaceRays : std::uint8_t {
   /// Every reading's ray (the paper).
@@ -125,6 +130,17 @@ struct InsertionConfig {
   /// See FreeSpaceRays (the README's decisions table: measured agreement with every reading's
   /// walk in BENCHMARKS.md).
   FreeSpaceRays free_space_rays = FreeSpaceRays::kOnePerEndVoxel;
+  /// Bounded evidence (OctoMap's clamping): after a scan's update of a column, a volume whose
+  /// density (eq. 2) and the highest density of the other list's volumes it overlaps sum to more
+  /// than this has its mass scaled down so that they sum to it (boundEvidence). A height then
+  /// remembers at most this many scans (with MassCounting::kPerScan), and each new scan weighs
+  /// at least its share: a wall cell that grazing rays crossed in many scans is occupied again
+  /// after a few hits, a place a person left clears within a few scans, where unbounded sums
+  /// take as many scans as came before. Scaling both lists alike keeps p (eq. 9) where they
+  /// overlap. Not saved in the map file (as OctoMap's clamping is not in its .ot files). With
+  /// MassCounting::kPerReading (the paper's rules) densities count readings, not scans, and are
+  /// unbounded whatever it says. Infinity: unbounded.
+  double evidence_limit = kDefaultEvidenceLimit;
 
   /// Throws ConfigError naming the first invalid field.
   void validate() const;

@@ -7,6 +7,35 @@
 
 namespace mvog {
 
+/// boundEvidence for a volume that no volume of the other list overlaps: its mass is at most
+/// max_density times its height (what the factor max_density / density gives, without a
+/// division).
+inline void boundAlone(Volume& volume, double max_density) {
+  const double max_mass = max_density * (static_cast<double>(volume.top) - volume.bottom);
+  if (volume.mass > max_mass) volume.mass = static_cast<float>(max_mass);
+}
+
+/// boundEvidence for a column with both lists.
+void boundEvidenceOfBoth(Volume* positive, std::size_t num_positive, Volume* negative,
+                         std::size_t num_negative, double max_density, std::vector<double>& work);
+
+/// InsertionConfig::evidence_limit on one column's lists (`positive`, `negative`: sorted, each
+/// satisfying Sec. III-A) after an update: a volume whose density and the highest density of
+/// the other list's volumes overlapping it (by a positive height) sum to more than `max_density`
+/// has its mass multiplied by max_density / that sum (one that nothing overlaps: boundAlone).
+/// Every factor is found from the densities before any mass changes, so that two volumes
+/// overlapping only each other are scaled alike and p of eq. (9) between them stays. `work` is
+/// working memory. Inline for a column of one list (a free column's commonest update).
+inline void boundEvidence(Volume* positive, std::size_t num_positive, Volume* negative,
+                          std::size_t num_negative, double max_density, std::vector<double>& work) {
+  if (num_positive != 0 && num_negative != 0) {
+    boundEvidenceOfBoth(positive, num_positive, negative, num_negative, max_density, work);
+    return;
+  }
+  Volume* list = num_positive == 0 ? negative : positive;
+  for (std::size_t k = 0; k < num_positive + num_negative; ++k) boundAlone(list[k], max_density);
+}
+
 /// A read-only run of volumes (a list, or new volumes for one).
 struct VolumeRun {
   const Volume* data = nullptr;

@@ -34,7 +34,7 @@ struct SensorInputsConfig {
 
 /// The insertion worker (InsertionWorker): the core's insertion parameters (~min_range,
 /// ~max_range, ~insert_out_of_range, ~model_negative_space, ~insertion_threads,
-/// ~free_space_rays), and its queue.
+/// ~free_space_rays, ~evidence_limit), and its queue.
 /// The model's rules are the map's (MapperConfig::map: ~model, ~clip_free_space_at_hits, ...).
 struct InsertionWorkerConfig : mvog::InsertionConfig {
   int insertion_queue_size = 3;  // converted messages waiting to be inserted

@@ -28,6 +28,8 @@ void InsertionConfig::validate() const {
   require(min_range < max_range, "min_range", "must be smaller than max_range");
   require(insertion_threads >= 1 && insertion_threads <= 256, "insertion_threads",
           "must be in [1, 256]");
+  require(evidence_limit >= 1.0, "evidence_limit",
+          "must be >= 1 (a scan's own density), infinity for no limit");
   require(free_space_rays == FreeSpaceRays::kEveryReading ||
               free_space_rays == FreeSpaceRays::kOnePerEndVoxel,
           "free_space_rays", "must be kEveryReading or kOnePerEndVoxel");

@@ -227,6 +227,79 @@ bool ListMerger::keepsUnchanged(VolumeRun negative, VolumeRun obstacles, FreeSpa
   return true;
 }
 
+namespace {
+
+/// The factor of boundEvidence for a volume of density `density` whose densest overlapping
+/// volume of the other list has density `densest`; 0 where that is 0 (the volume is bounded
+/// alone, boundAlone).
+double evidenceFactor(double density, double densest, double max_density) {
+  if (densest == 0.0) return 0.0;
+  const double sum = density + densest;
+  return sum > max_density ? max_density / sum : 1.0;
+}
+
+/// Writes to factors[k] the factor of list[k] against the volumes of `other`, whose densities
+/// are other_density[0, other_size).
+void evidenceFactors(const Volume* list, const double* density, std::size_t size,
+                     const Volume* other, const double* other_density, std::size_t other_size,
+                     double max_density, double* factors) {
+  std::size_t first = 0;  // the first volume of `other` that may overlap the current one
+  for (std::size_t k = 0; k < size; ++k) {
+    while (first < other_size && other[first].top <= list[k].bottom) ++first;
+    double densest = 0.0;
+    for (std::size_t j = first; j < other_size && other[j].bottom < list[k].top; ++j) {
+      densest = std::max(densest, other_density[j]);
+    }
+    factors[k] = evidenceFactor(density[k], densest, max_density);
+  }
+}
+
+/// Scales `volume`'s mass by `factor`, or bounds it alone where the factor is 0 (nothing of the
+/// other list overlaps it).
+void scaleMass(Volume& volume, double factor, double max_density) {
+  if (factor == 0.0) {
+    boundAlone(volume, max_density);
+  } else if (factor != 1.0) {
+    volume.mass = static_cast<float>(volume.mass * factor);
+  }
+}
+
+}  // namespace
+
+void boundEvidenceOfBoth(Volume* positive, std::size_t num_positive, Volume* negative,
+                         std::size_t num_negative, double max_density, std::vector<double>& work) {
+  if (num_positive == 1 && num_negative == 1) {
+    // A column of one obstacle and one free volume (a 2D laser's wall, mostly): no memory.
+    Volume& p = positive[0];
+    Volume& n = negative[0];
+    if (!(p.bottom < n.top && n.bottom < p.top)) {
+      boundAlone(p, max_density);
+      boundAlone(n, max_density);
+      return;
+    }
+    const double p_density = p.density();
+    const double n_density = n.density();
+    scaleMass(p, evidenceFactor(p_density, n_density, max_density), max_density);
+    scaleMass(n, evidenceFactor(n_density, p_density, max_density), max_density);
+    return;
+  }
+  // Every density once, then every factor from them, then the masses.
+  const std::size_t size = num_positive + num_negative;
+  work.resize(2 * size);
+  double* density = work.data();
+  double* factor = density + size;
+  for (std::size_t k = 0; k < num_positive; ++k) density[k] = positive[k].density();
+  for (std::size_t k = 0; k < num_negative; ++k) density[num_positive + k] = negative[k].density();
+  evidenceFactors(positive, density, num_positive, negative, density + num_positive, num_negative,
+                  max_density, factor);
+  evidenceFactors(negative, density + num_positive, num_negative, positive, density, num_positive,
+                  max_density, factor + num_positive);
+  for (std::size_t k = 0; k < num_positive; ++k) scaleMass(positive[k], factor[k], max_density);
+  for (std::size_t k = 0; k < num_negative; ++k) {
+    scaleMass(negative[k], factor[num_positive + k], max_density);
+  }
+}
+
 void ListMerger::cutAsTheMergeDoes(std::vector<Volume>& negative, VolumeRun obstacles,
                                    FreeSpaceRules rules) {
   if (keepsUnchanged(negative, obstacles, rules)) return;

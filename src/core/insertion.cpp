@@ -332,9 +332,18 @@ bool mergeWithoutContact(const detail::ColumnRef& existing, const CellVolumes& a
 /// into the cell's lists `existing`, in place where their lengths stay, else into the tile's
 /// rewrite. Out of line: the loop over a tile's cells then keeps the commonest case's values in
 /// registers.
+/// InsertionConfig::evidence_limit (`max_density`, in the tile's unit; infinite: none) on a
+/// column changed in place.
+void boundStoredColumn(const detail::ColumnRef& column, double max_density,
+                       std::vector<double>& factors) {
+  if (std::isinf(max_density)) return;
+  boundEvidence(const_cast<Volume*>(column.positive), column.num_positive,
+                const_cast<Volume*>(column.negative), column.num_negative, max_density, factors);
+}
+
 [[gnu::noinline]] void updateColumn(unsigned local, HitRun hits, detail::ColumnRef existing,
-                                    const ModelRules& rules, float unit_mass, CellIndex origin,
-                                    ColumnWork& work) {
+                                    const ModelRules& rules, float unit_mass, double max_density,
+                                    CellIndex origin, ColumnWork& work) {
   Volume* stored = const_cast<Volume*>(existing.positive);
   scanColumn(local, hits, detail::joinGapOf(rules), work);
   addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
@@ -347,6 +356,7 @@ bool mergeWithoutContact(const detail::ColumnRef& existing, const CellVolumes& a
                                existing.num_negative,
                                VolumeRun(existing.positive, existing.num_positive), unit_mass))
           : addWithinExistingVolumes(work.added, existing, free_space_rules, work.merger)) {
+    boundStoredColumn(existing, max_density, work.evidence_factors);
     return;
   }
   // A column without obstacles, before and after, is merged in one pass by ListMerger: no need
@@ -366,6 +376,10 @@ bool mergeWithoutContact(const detail::ColumnRef& existing, const CellVolumes& a
   }
   const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
   const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());
+  if (!std::isinf(max_density)) {
+    boundEvidence(work.merged.positive.data(), num_positive, work.merged.negative.data(),
+                  num_negative, max_density, work.evidence_factors);
+  }
   if (!existing.empty() && num_positive == existing.num_positive &&
       num_negative == existing.num_negative) {
     // Mostly every list keeps its length (new volumes merge into those there).
@@ -381,8 +395,8 @@ bool mergeWithoutContact(const detail::ColumnRef& existing, const CellVolumes& a
 /// Merges the new volumes of the scan's scratches into the columns of tile `key`.
 MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
                                      const std::vector<detail::ScanScratch>& scratches,
-                                     const ModelRules& rules, float unit_mass, double rescale,
-                                     std::int32_t exponent, std::uint64_t revision,
+                                     const ModelRules& rules, float unit_mass, double max_density,
+                                     double rescale, std::int32_t exponent, std::uint64_t revision,
                                      ColumnWork& work) {
   gatherTile(key, scratches, work);
   // The tile was written before a decay step: bring its masses to the current unit first.
@@ -404,9 +418,12 @@ MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
           only_part->first->singleFree(*only_part->second, local, single)) {
         // The commonest cases without a vector in between: one free interval, no hit, changed
         // in the tile's own storage, or a cell's first volume.
-        const Volume added{single.bottom, single.top,
-                           massOf(single, single.bottom, single.top, per_scan, unit_mass)};
+        Volume added{single.bottom, single.top,
+                     massOf(single, single.bottom, single.top, per_scan, unit_mass)};
         if (existing.empty()) {
+          if (!std::isinf(max_density)) {
+            boundEvidence(nullptr, 0, &added, 1, max_density, work.evidence_factors);
+          }
           // What the merge makes of one free volume and empty lists: that volume (a scan's free
           // interval is at least kMinVolumeHeight high, so no rule cuts it, and its mass, a sum
           // of heights times the unit, is never -0, which the merge's 0.0 + mass would make +0).
@@ -416,10 +433,11 @@ MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
         }
         Volume* negative = const_cast<Volume*>(existing.negative);
         if (addCoveredFreeSpace(VolumeRun(&added, 1), negative, existing.num_negative)) {
+          boundStoredColumn(existing, max_density, work.evidence_factors);
           continue;
         }
       }
-      updateColumn(local, hits, existing, rules, unit_mass, origin, work);
+      updateColumn(local, hits, existing, rules, unit_mass, max_density, origin, work);
     }
   }
   if (work.rewrite.empty()) {
@@ -467,6 +485,9 @@ InsertionResult Map::apply(ScanUpdate& update) {
   for (std::size_t k = 0; k < keys.size(); ++k) tiles[k] = &storage_->tiles[keys[k]];
 
   const float unit_mass = static_cast<float>(1.0 / mass_unit_);
+  // InsertionConfig::evidence_limit in the unit masses are stored in (a scan's density 1 is
+  // unit_mass).
+  const double max_density = impl.evidence_limit * unit_mass;
   const auto exponent = static_cast<std::int32_t>(unit_exponent_);
   const std::size_t num_threads = impl.scratches.size();
   std::vector<ColumnWork>& work = impl.column_work;
@@ -475,8 +496,8 @@ InsertionResult Map::apply(ScanUpdate& update) {
   auto update_tile = [&](std::size_t worker, std::size_t k) {
     detail::TileBlock& tile = *tiles[k];
     const double rescale = tile.empty() ? 1.0 : rescaleOf(tile.exponent());
-    updateTile(tile, keys[k], impl.scratches, config_.rules, unit_mass, rescale, exponent,
-               revision_, work[worker]);
+    updateTile(tile, keys[k], impl.scratches, config_.rules, unit_mass, max_density, rescale,
+               exponent, revision_, work[worker]);
   };
   if (detail::ThreadPool* pool = impl.threads(num_threads)) {
     pool->run(keys.size(), update_tile);

@@ -510,6 +510,7 @@ struct alignas(kCacheLine) ColumnWork {
   std::vector<ScanInterval> free;
   std::vector<ScanInterval> positive;
   CellVolumes added;
+  std::vector<double> evidence_factors;  // boundEvidence's
   CellVolumes merged;
   /// The new lists of the tile's cells whose lists changed length.
   TileBlock::Rewrite rewrite;
@@ -520,6 +521,8 @@ struct alignas(kCacheLine) ColumnWork {
 
 struct ScanUpdate::Impl {
   MapConfig map_config;
+  /// InsertionConfig::evidence_limit of the scan prepared (Map::apply bounds the columns with it).
+  double evidence_limit = std::numeric_limits<double>::infinity();
   InsertionResult result;
   /// One per chunk of readings (one per thread).
   std::vector<detail::ScanScratch> scratches;

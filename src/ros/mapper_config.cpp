@@ -278,6 +278,7 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   std::string free_space_rays = "one_per_end_voxel";
   read(nh, "free_space_rays", free_space_rays);
   insertion.free_space_rays = freeSpaceRaysFromName(free_space_rays);
+  read(nh, "evidence_limit", insertion.evidence_limit);
   read(nh, "insertion_queue_size", insertion.insertion_queue_size);
   read(nh, "backlog_insertion_threads", insertion.backlog_insertion_threads);
 

@@ -156,6 +156,11 @@ class ReferenceModel {
       merger.merge(cell.negative, added_free, positive,
                    {rules.split_free_space_at_obstacles, rules.clip_free_space_at_hits}, 1.0f,
                    negative);
+      if (per_scan && std::isfinite(insertion.evidence_limit)) {  // evidence_limit
+        std::vector<double> factors;
+        boundEvidence(positive.data(), positive.size(), negative.data(), negative.size(),
+                      insertion.evidence_limit, factors);
+      }
       cell.positive = positive;
       cell.negative = negative;
       if (cell.positive.empty() && cell.negative.empty()) cells_.erase(key);

@@ -332,6 +332,7 @@ TEST(Insertion, HitsInsideOneObstacleAddTheirMassesInOneSum) {
   scan.hits = {{0.5f, 0.5f, 2.0f}, {0.5f, 0.5f, 7.0f}};  // [1.5, 2.5] and [6.5, 7.5], mass 1 each
   InsertionConfig config;
   config.model_negative_space = false;
+  config.evidence_limit = std::numeric_limits<double>::infinity();  // the sum itself is tested
   map.insertScan(scan, config);
   const CellVolumes held = map.cellVolumes({0, 0});
   ASSERT_EQ(held.positive.size(), 1u);
@@ -585,18 +586,27 @@ std::string describe(const ModelRules& rules) {
   return text.str();
 }
 
-/// Insertions walking every reading's ray and one ray per end voxel (FreeSpaceRays).
+/// Insertions walking every reading's ray and one ray per end voxel (FreeSpaceRays), each with
+/// unbounded evidence and with InsertionConfig::evidence_limit 3 (reached within the tests'
+/// scans).
 std::vector<InsertionConfig> everyRayChoice() {
-  InsertionConfig every_reading;
-  every_reading.free_space_rays = FreeSpaceRays::kEveryReading;
-  InsertionConfig one_per_end_voxel;
-  one_per_end_voxel.free_space_rays = FreeSpaceRays::kOnePerEndVoxel;
-  return {every_reading, one_per_end_voxel};
+  std::vector<InsertionConfig> choices;
+  for (FreeSpaceRays rays : {FreeSpaceRays::kEveryReading, FreeSpaceRays::kOnePerEndVoxel}) {
+    for (double evidence_limit : {std::numeric_limits<double>::infinity(), 3.0}) {
+      InsertionConfig insertion;
+      insertion.free_space_rays = rays;
+      insertion.evidence_limit = evidence_limit;
+      choices.push_back(insertion);
+    }
+  }
+  return choices;
 }
 
 std::string describe(const InsertionConfig& insertion) {
-  return insertion.free_space_rays == FreeSpaceRays::kEveryReading ? ", every reading's ray"
-                                                                   : ", one ray per end voxel";
+  return std::string(insertion.free_space_rays == FreeSpaceRays::kEveryReading
+                         ? ", every reading's ray"
+                         : ", one ray per end voxel") +
+         (std::isinf(insertion.evidence_limit) ? "" : ", evidence limit 3");
 }
 
 /// Scans from a few origins over about 8 x 8 tiles, with hits near each other (so that columns

@@ -2,6 +2,7 @@
 // message naming it. (fromParameters needs a master: the rostests cover it.)
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -323,6 +324,17 @@ TEST(MapperConfig, RefusesAnUnknownFreeSpaceRaysNamingIt) {
   expectRefused({"free_space_rays", "not a FreeSpaceRays", [](MapperConfig& c) {
                    c.insertion.free_space_rays = static_cast<mvog::FreeSpaceRays>(7);
                  }});
+}
+
+TEST(MapperConfig, EvidenceLimitDefaultsToTheCoresAndRefusesLessThanOneNamingIt) {
+  EXPECT_EQ(validConfig().insertion.evidence_limit, mvog::kDefaultEvidenceLimit);
+  MapperConfig unbounded = validConfig();
+  unbounded.insertion.evidence_limit = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(refusal(unbounded), "");
+  for (double limit : {0.5, 0.0, -1.0, std::nan("")}) {
+    expectRefused({"evidence_limit", std::to_string(limit),
+                   [limit](MapperConfig& c) { c.insertion.evidence_limit = limit; }});
+  }
 }
 
 TEST(MapperConfig, AnEmptyAutosaveFileIsFineWhileAutosaveIsOff) {

@@ -52,6 +52,7 @@ MvogRun runMvog(const InputData& input, const RunOptions& options) {
   insertion.max_range = options.max_range;
   insertion.insertion_threads = options.threads;
   insertion.free_space_rays = options.free_space_rays;
+  insertion.evidence_limit = options.evidence_limit;
   MvogRun run{mvog::Map(map_config), {}};
   MvogStats& stats = run.stats;
   stats.threads = options.threads;

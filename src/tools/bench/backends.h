@@ -34,6 +34,8 @@ struct RunOptions {
   /// OctoMap only: its log-odds clamped to [logodds(0.1192), logodds(0.971)] at each update (its
   /// default), or not clamped at all (OcTree::setClampingThresMin(0), setClampingThresMax(1)).
   bool octomap_clamping = true;
+  /// MVOG only: InsertionConfig::evidence_limit.
+  double evidence_limit = mvog::InsertionConfig{}.evidence_limit;
 };
 
 /// Seconds from `start` to now (steady clock): what each backend's insertion took.

@@ -6,7 +6,7 @@
 //              [--model default|paper] [--clip-free-space-at-hits on|off]
 //              [--mass-counting per-scan|per-reading] [--split-free-space-at-obstacles on|off]
 //              [--free-space-rays one-per-end-voxel|every-reading]
-//              [--octomap-clamping on|off]
+//              [--octomap-clamping on|off] [--evidence-limit E|inf]
 //              [--truth-slice OUT.ppm]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
 #include <algorithm>
@@ -42,6 +42,7 @@ struct Arguments {
   bool out_of_range = false;  ///< default: the rules' (the paper's for --model paper)
   mvog::FreeSpaceRays free_space_rays = mvog::InsertionConfig{}.free_space_rays;
   bool octomap_clamping = true;
+  double evidence_limit = mvog::InsertionConfig{}.evidence_limit;
   bool run_mvog = false;
   bool run_octomap = false;
   bool run_bonxai = false;
@@ -67,7 +68,7 @@ constexpr const char* kUsage =
     "                  [--split-free-space-at-obstacles on|off] [--occupancy-threshold T]\n"
     "                  [--out-of-range-free-length L|inf]\n"
     "                  [--free-space-rays one-per-end-voxel|every-reading]\n"
-    "                  [--octomap-clamping on|off]\n"
+    "                  [--octomap-clamping on|off] [--evidence-limit E|inf]\n"
     "                  [--truth-slice OUT.ppm]\n"
     "  FILE        a ROS bag (LaserScan, PointCloud2 and/or depth Image 16UC1 or 32FC1 with\n"
     "              CameraInfo; poses from /tf and /tf_static)\n"
@@ -97,6 +98,8 @@ constexpr const char* kUsage =
     "              it change one rule each (mvog::ModelRules, README's decisions table)\n"
     "  --free-space-rays  MVOG walks one ray per end voxel (the default) or every reading's\n"
     "              (mvog::FreeSpaceRays)\n"
+    "  E           MVOG's evidence limit in scans, with per-scan masses\n"
+    "              (mvog::InsertionConfig::evidence_limit; default 14)\n"
     "  --octomap-clamping  OctoMap's log-odds clamped at each update (on, its default) or\n"
     "              not (off: every hit and miss counts, as MVOG's masses do)\n"
     "  --truth-slice  with truth:NAME, a cross-section of the scene with each map's errors\n"
@@ -192,6 +195,9 @@ Arguments parseArguments(int argc, char** argv) {
       }
       arguments.free_space_rays = value == "every-reading" ? mvog::FreeSpaceRays::kEveryReading
                                                            : mvog::FreeSpaceRays::kOnePerEndVoxel;
+    } else if (option == "--evidence-limit") {
+      arguments.evidence_limit =
+          value == "inf" ? std::numeric_limits<double>::infinity() : positiveNumber(option, value);
     } else if (option == "--octomap-clamping") {
       arguments.octomap_clamping = onOff(option, value);
     } else if (option == "--json") {
@@ -250,6 +256,7 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   options.out_of_range = arguments.out_of_range;
   options.free_space_rays = arguments.free_space_rays;
   options.octomap_clamping = arguments.octomap_clamping;
+  options.evidence_limit = arguments.evidence_limit;
   mvog_bench::ResolutionReport report;
   report.resolution = resolution;
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
@@ -400,6 +407,9 @@ int main(int argc, char** argv) {
     report.rules = arguments.rules;
     report.octomap_clamping = arguments.octomap_clamping;
     report.occupancy_threshold = occupancyThreshold(arguments);
+    report.evidence_limit = arguments.rules.mass_counting == mvog::MassCounting::kPerScan
+                                ? arguments.evidence_limit
+                                : std::numeric_limits<double>::infinity();  // not applied
     report.out_of_range = arguments.out_of_range;
     report.repeat = arguments.repeat;
     const auto start = std::chrono::steady_clock::now();

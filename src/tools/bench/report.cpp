@@ -256,9 +256,10 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
   } else {
     std::fprintf(out, "max range   none\n");
   }
-  std::fprintf(out, "MVOG rules  %s%s; occupied where p > %.3f\n", rulesText(report.rules).c_str(),
+  std::fprintf(out, "MVOG rules  %s%s; occupied where p > %.3f; evidence limit %g\n",
+               rulesText(report.rules).c_str(),
                report.rules == mvog::ModelRules::paper() ? " (the paper's model)" : "",
-               report.occupancy_threshold);
+               report.occupancy_threshold, report.evidence_limit);
   std::fprintf(out, "OctoMap     log-odds clamping %s\n\n",
                report.octomap_clamping ? "on (its default)" : "off");
 
@@ -539,6 +540,7 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
       .add("out_of_range_to_mvog", report.out_of_range)
       .add("occupancy_threshold", report.occupancy_threshold)
       .add("octomap_clamping", report.octomap_clamping)
+      .add("evidence_limit", report.evidence_limit)
       .add("repeat", report.repeat)
       .add("table_one", table_one)
       .add("quality", quality)

@@ -46,6 +46,7 @@ struct BenchReport {
   mvog::ModelRules rules;
   double occupancy_threshold = 0.0;
   bool octomap_clamping = true;  ///< RunOptions::octomap_clamping
+  double evidence_limit = 0.0;   ///< RunOptions::evidence_limit, as applied (infinity: none)
   bool out_of_range = false;     ///< the out-of-range readings were given to MVOG
   int repeat = 1;                ///< insertions per backend; the fastest is reported
   std::vector<ResolutionReport> resolutions;
