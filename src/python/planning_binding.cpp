@@ -109,6 +109,30 @@ std::vector<mvog::Surface> surfaceList(const mvog::Surfaces& surfaces) {
   return surfaces.surfaces();
 }
 
+/// The class of a result kept tile by tile (Frontiers, Surfaces): its constructor from a
+/// PlanningConfig, update(map) returning `items` as a structured array, and clear().
+template <class Core, class Item>
+py::class_<Guarded<Core>> trackedClass(py::module_& module, const char* name, const char* doc,
+                                       std::vector<Item> (*items)(const Core&),
+                                       const char* update_doc) {
+  py::class_<Guarded<Core>> tracked(module, name, doc);
+  tracked.def(py::init<const mvog::PlanningConfig&>(), py::arg("config") = mvog::PlanningConfig{})
+      .def(
+          "update",
+          [items](Guarded<Core>& guarded, const MapHandle& handle) {
+            return arrayOf(updated(guarded, handle, items));
+          },
+          py::arg("map"), update_doc)
+      .def(
+          "clear",
+          [](Guarded<Core>& guarded) {
+            const std::lock_guard<std::mutex> own(guarded.mutex);
+            guarded.core.clear();
+          },
+          "Forgets everything (call it after the map is replaced by another).");
+  return tracked;
+}
+
 }  // namespace
 
 void bindPlanning(py::module_& module) {
@@ -152,55 +176,28 @@ void bindPlanning(py::module_& module) {
       "int8 Traversability values (-1 unknown, 0 traversable, 100 blocked). ValueError for an "
       "empty map or rectangle.");
 
-  py::class_<Guarded<mvog::Frontiers>>(
+  trackedClass<mvog::Frontiers>(
       module, "Frontiers",
       "The frontiers of a map (known-free space that touches unknown space) within "
       "[config.frontier_min_z, config.frontier_max_z], kept tile by tile: update(map) recomputes "
-      "the tiles that changed since the previous update.")
-      .def(py::init<const mvog::PlanningConfig&>(), py::arg("config") = mvog::PlanningConfig{})
-      .def(
-          "update",
-          [](Guarded<mvog::Frontiers>& frontiers, const MapHandle& handle) {
-            return arrayOf(updated(frontiers, handle, &frontierPoints));
-          },
-          py::arg("map"),
-          "Brings the frontiers up to date with `map`; returns its frontier voxels as a "
-          "structured array: x, y, z (float32, the voxel's centre, m, map frame) and cluster "
-          "(uint32, its connected piece).")
-      .def(
-          "clear",
-          [](Guarded<mvog::Frontiers>& frontiers) {
-            const std::lock_guard<std::mutex> own(frontiers.mutex);
-            frontiers.core.clear();
-          },
-          "Forgets everything (call it after the map is replaced by another).")
+      "the tiles that changed since the previous update.",
+      &frontierPoints,
+      "Brings the frontiers up to date with `map`; returns its frontier voxels as a structured "
+      "array: x, y, z (float32, the voxel's centre, m, map frame) and cluster (uint32, its "
+      "connected piece).")
       .def_property_readonly("num_clusters", [](Guarded<mvog::Frontiers>& frontiers) {
         const std::lock_guard<std::mutex> own(frontiers.mutex);
         return frontiers.core.numClusters();
       });
-
-  py::class_<Guarded<mvog::Surfaces>>(
+  trackedClass<mvog::Surfaces>(
       module, "Surfaces",
       "The surfaces (tops of occupied space) of every column of a map, kept tile by tile: "
-      "update(map) recomputes the tiles that changed.")
-      .def(py::init<const mvog::PlanningConfig&>(), py::arg("config") = mvog::PlanningConfig{})
-      .def(
-          "update",
-          [](Guarded<mvog::Surfaces>& surfaces, const MapHandle& handle) {
-            return arrayOf(updated(surfaces, handle, &surfaceList));
-          },
-          py::arg("map"),
-          "Brings the surfaces up to date with `map`; returns them as a structured array: x, "
-          "y (float32, the cell's centre, m), z (the top's height, m), clearance (m of known "
-          "free space above it), capped (bool: occupied space ends the clearance) and "
-          "probability (eq. 9 just below the top).")
-      .def(
-          "clear",
-          [](Guarded<mvog::Surfaces>& surfaces) {
-            const std::lock_guard<std::mutex> own(surfaces.mutex);
-            surfaces.core.clear();
-          },
-          "Forgets everything (call it after the map is replaced by another).");
+      "update(map) recomputes the tiles that changed.",
+      &surfaceList,
+      "Brings the surfaces up to date with `map`; returns them as a structured array: x, y "
+      "(float32, the cell's centre, m), z (the top's height, m), clearance (m of known free "
+      "space above it), capped (bool: occupied space ends the clearance) and probability (eq. 9 "
+      "just below the top).");
 }
 
 }  // namespace mvog_python
