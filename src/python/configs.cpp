@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "bindings.h"
@@ -41,8 +42,17 @@ class ConfigClass {
 
   template <class Field>
   ConfigClass& field(const char* name, Field Config::*member, const char* doc) {
+    // A struct field (MapConfig.rules) is returned by reference, so that `config.rules.x = v`
+    // changes the config (each of its own fields validated as it is set); other fields by value.
+    py::cpp_function getter;
+    if constexpr (std::is_class_v<Field>) {
+      getter = py::cpp_function([member](Config& config) -> Field& { return config.*member; },
+                                py::return_value_policy::reference_internal);
+    } else {
+      getter = py::cpp_function([member](const Config& config) { return config.*member; });
+    }
     class_.def_property(
-        name, [member](const Config& config) { return config.*member; },
+        name, getter,
         [member](Config& config, const Field& value) {
           Config changed = config;
           changed.*member = value;

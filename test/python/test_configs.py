@@ -86,10 +86,21 @@ def test_a_bad_assignment_raises_and_keeps_the_old_value():
     assert rules == mvog.ModelRules()
 
 
+def test_a_configs_rules_change_in_place():
+    config = mvog.MapConfig()
+    config.rules.out_of_range_free_length = 5.0
+    assert config.rules.out_of_range_free_length == 5.0
+    with pytest.raises(ValueError, match="out_of_range_free_length"):
+        config.rules.out_of_range_free_length = 0.0
+    assert mvog.Map(config).config.rules.out_of_range_free_length == 5.0
+
+
 def test_a_map_takes_its_config_and_copies_are_independent():
     config = mvog.MapConfig(resolution=0.25, rules=mvog.ModelRules.paper())
     other = copy.deepcopy(config)
     other.resolution = 0.5
+    other.rules.out_of_range_free_length = 3.0
+    assert config.rules == mvog.ModelRules.paper()
     assert mvog.Map(config).resolution == 0.25
     assert mvog.Map(config).config.rules == mvog.ModelRules.paper()
     assert "resolution=0.25" in repr(config)
