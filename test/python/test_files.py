@@ -42,9 +42,11 @@ def test_the_map_python_builds_from_the_same_rays_is_the_cpp_map(reference):
     assert mvog.serialize_map(world) == (directory / "map.mvog").read_bytes()
 
 
-def test_a_truncated_or_corrupt_file_raises_map_file_error(reference, tmp_path):
-    directory, _ = reference
-    data = (directory / "map.mvog").read_bytes()
+def test_a_truncated_or_corrupt_file_raises_map_file_error(tmp_path):
+    world = mvog.Map()
+    world.insert_scan([0, 0, 1], np.random.default_rng(2).uniform(-3, 3, (500, 3)))
+    mvog.save_map(world, tmp_path / "whole.mvog")
+    data = (tmp_path / "whole.mvog").read_bytes()
     truncated = tmp_path / "truncated.mvog"
     truncated.write_bytes(data[:len(data) // 2])
     with pytest.raises(mvog.MapFileError):
