@@ -135,6 +135,10 @@ void bindMap(py::module_& module) {
       .def_readonly("rejected_too_close", &mvog::InsertionResult::rejected_too_close)
       .def_readonly("ignored_out_of_range", &mvog::InsertionResult::ignored_out_of_range)
       .def_readonly("rays_walked", &mvog::InsertionResult::rays_walked)
+      .def_readonly("obstacle_seconds", &mvog::InsertionResult::obstacle_seconds,
+                    "thread time rasterising the obstacle readings (s)")
+      .def_readonly("out_of_range_seconds", &mvog::InsertionResult::out_of_range_seconds,
+                    "thread time rasterising the out-of-range readings (s)")
       .def_property_readonly("inserted", &mvog::InsertionResult::inserted)
       .def_property_readonly("rejected", &mvog::InsertionResult::rejected)
       .def("__repr__", [](const mvog::InsertionResult& r) {

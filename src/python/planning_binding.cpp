@@ -38,9 +38,13 @@ py::array_t<Item> arrayOf(const std::vector<Item>& items) {
   return py::array_t<Item>(static_cast<py::ssize_t>(items.size()), items.data());
 }
 
-std::pair<py::array_t<std::uint8_t>, py::array_t<double>> checkSegments(
-    const MapHandle& handle, const py::handle& starts, const py::handle& ends, double radius,
-    const mvog::PlanningConfig& config) {
+/// The segments starts[k] -> ends[k] checked by `check(map, segments)` on the map locked for
+/// reading, without the GIL: (states, blocked_at).
+template <class Check>
+std::pair<py::array_t<std::uint8_t>, py::array_t<double>> segmentChecks(const MapHandle& handle,
+                                                                        const py::handle& starts,
+                                                                        const py::handle& ends,
+                                                                        Check&& check) {
   const PointArray start_points(starts, "starts");
   const PointArray end_points(ends, "ends");
   requireSameSize(start_points, "starts", end_points, "ends");
@@ -53,8 +57,7 @@ std::pair<py::array_t<std::uint8_t>, py::array_t<double>> checkSegments(
     for (std::size_t k = 0; k < segments.size(); ++k) {
       segments[k] = {start_points.point(k), end_points.point(k)};
     }
-    const std::vector<mvog::SegmentCheck> checks =
-        mvog::checkSegments(map, segments, radius, config);
+    const std::vector<mvog::SegmentCheck> checks = check(map, segments);
     for (std::size_t k = 0; k < checks.size(); ++k) {
       state[k] = static_cast<std::uint8_t>(checks[k].state);
       blocked[k] = checks[k].blocked_at;
@@ -62,6 +65,15 @@ std::pair<py::array_t<std::uint8_t>, py::array_t<double>> checkSegments(
     return 0;
   });
   return {states, blocked_at};
+}
+
+std::pair<py::array_t<std::uint8_t>, py::array_t<double>> checkSegments(
+    const MapHandle& handle, const py::handle& starts, const py::handle& ends, double radius,
+    const mvog::PlanningConfig& config) {
+  return segmentChecks(handle, starts, ends,
+                       [&](const mvog::Map& map, const std::vector<mvog::Segment>& segments) {
+                         return mvog::checkSegments(map, segments, radius, config);
+                       });
 }
 
 std::tuple<py::array_t<std::uint8_t>, py::array_t<double>, py::array_t<double>> checkBoxes(
@@ -198,6 +210,34 @@ void bindPlanning(py::module_& module) {
       "(float32, the cell's centre, m), z (the top's height, m), clearance (m of known free "
       "space above it), capped (bool: occupied space ends the clearance) and probability (eq. 9 "
       "just below the top).");
+
+  py::class_<Guarded<mvog::SegmentChecker>>(
+      module, "SegmentChecker",
+      "Checks segments as check_segments does, keeping from call to call what it found about "
+      "blocks of 4 x 4 cells (forgotten for the tiles that change): repeated checks on a map "
+      "pass open and unknown space without looking at each of its columns. Call clear() after "
+      "the map is replaced by another.")
+      .def(py::init<const mvog::PlanningConfig&>(), py::arg("config") = mvog::PlanningConfig{})
+      .def(
+          "check",
+          [](Guarded<mvog::SegmentChecker>& checker, const MapHandle& handle,
+             const py::handle& starts, const py::handle& ends, double radius) {
+            return segmentChecks(
+                handle, starts, ends,
+                [&](const mvog::Map& map, const std::vector<mvog::Segment>& segments) {
+                  const std::lock_guard<std::mutex> own(checker.mutex);
+                  return checker.core.check(map, segments, radius);
+                });
+          },
+          py::arg("map"), py::arg("starts"), py::arg("ends"), py::arg("radius") = 0.0,
+          "As check_segments(map, starts, ends, radius, config): (states, blocked_at).")
+      .def(
+          "clear",
+          [](Guarded<mvog::SegmentChecker>& checker) {
+            const std::lock_guard<std::mutex> own(checker.mutex);
+            checker.core.clear();
+          },
+          "Forgets the blocks (for a map replaced by another).");
 }
 
 }  // namespace mvog_python

@@ -78,6 +78,14 @@ def test_checks_of_segments_and_boxes():
     assert highest[0] > 0.5
     with pytest.raises(ValueError, match="max_query_cells"):
         mvog.check_segments(world, starts, ends, config=mvog.PlanningConfig(max_query_cells=1))
+    # The checker that keeps block summaries answers alike, before and after a change.
+    checker = mvog.SegmentChecker()
+    for _ in range(2):
+        kept = checker.check(world, starts, ends)
+        fresh = mvog.check_segments(world, starts, ends)
+        np.testing.assert_array_equal(kept[0], fresh[0])
+        np.testing.assert_array_equal(kept[1], fresh[1])
+        world.clear_box([0.0, 0.0, -1.0], [0.2, 0.2, 1.0])
 
 
 def test_surfaces_frontiers_and_the_traversable_map():
