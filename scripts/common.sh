@@ -25,6 +25,9 @@ MVOG_PACKAGES=(
   rviz tf2-tools liboctomap-dev octomap-tools
   xvfb xauth x11-utils libgl1-mesa-dri imagemagick valgrind
   clang-14 libclang-rt-14-dev clang-format-14 clang-tidy-14 catkin-lint shellcheck
+  # The Python module (src/python): pybind11 to build it, pytest for test/python, matplotlib for
+  # the example scripts/python_map_views.py.
+  pybind11-dev python3-dev python3-pytest python3-matplotlib
 )
 
 as_root() {

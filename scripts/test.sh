@@ -4,6 +4,7 @@
 # (catkin_lint, shellcheck, clang-tidy: scripts/lint.sh), then the sanitizer builds and fuzzing
 # (scripts/sanitizers.sh). Prints one summary line and exits
 # non-zero on any failure. Tests that replay ../shared/data skip without it, but not when CI=true.
+# The Python module's tests (test/python, pytest) run after the catkin tests and count alike.
 # shellcheck source=scripts/common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
@@ -82,6 +83,32 @@ if [ $((errors + test_failures)) -gt 0 ] || [ "$tests" -eq 0 ]; then
   failures+=("catkin tests: $(grep -vE '^Summary:' <<<"$results" | grep -E 'errors|failures|Error' | head -20)")
 fi
 stage "catkin tests"
+
+# 2b. The Python module's tests (test/python, pytest), from the workspace sourced above, where
+# `import mvog` finds the built module: counted from pytest's JUnit XML (its tests, failures,
+# errors and skips). Their recording skips without ../shared/data, but not when CI=true.
+pytest_xml=$LOG_DIR/pytest.xml
+rm -f "$pytest_xml"
+quietly pytest bash -c "cd '$WORKSPACE' && python3 -m pytest -p no:cacheprovider \
+  --junitxml='$pytest_xml' '$REPO/test/python'" || true
+read -r py_tests py_failed py_skipped < <(python3 - "$pytest_xml" <<'PY' || echo "0 0 0"
+import sys
+import xml.etree.ElementTree as ET
+suites = ET.parse(sys.argv[1]).getroot()
+suites = [suites] if suites.tag == "testsuite" else list(suites)
+count = lambda name: sum(int(suite.get(name, 0)) for suite in suites)
+print(count("tests"), count("failures") + count("errors"), count("skipped"))
+PY
+)
+passed=$((passed + py_tests - py_failed - py_skipped))
+# No test run at all (no XML: pytest missing, the module not built) fails the stage.
+if [ "$py_tests" -eq 0 ]; then py_failed=1; fi
+failed=$((failed + py_failed))
+skipped=$((skipped + py_skipped))
+if [ "$py_failed" -gt 0 ]; then
+  failures+=("python tests: $(grep -E '^(FAILED|ERROR)' "$LOG_DIR/pytest.log" | head -10) (log: $LOG_DIR/pytest.log)")
+fi
+stage "python tests"
 
 # count_script NAME: adds the counts of scripts/NAME.sh from its log, whose last line is
 # "NAME: N passed, N failed, N skipped" (one failure if it printed none).
