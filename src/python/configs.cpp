@@ -180,18 +180,24 @@ void bindConfigs(py::module_& module) {
       .field("insertion_threads", &mvog::InsertionConfig::insertion_threads,
              "Threads of one insertion, in [1, 256]; the map is the same for any count.")
       .field("free_space_rays", &mvog::InsertionConfig::free_space_rays, "See FreeSpaceRays.")
+      .field("evidence_limit", &mvog::InsertionConfig::evidence_limit,
+             "Scans of evidence a height keeps (bounded evidence, OctoMap's clamping); >= 1, inf "
+             "for none. Unbounded with per-reading masses (the paper's rules).")
       .done()
       .def(py::init([](double min_range, double max_range, bool insert_out_of_range,
-                       bool model_negative_space, int threads, mvog::FreeSpaceRays rays) {
+                       bool model_negative_space, int threads, mvog::FreeSpaceRays rays,
+                       double evidence_limit) {
              return validated(mvog::InsertionConfig{min_range, max_range, insert_out_of_range,
-                                                    model_negative_space, threads, rays});
+                                                    model_negative_space, threads, rays,
+                                                    evidence_limit});
            }),
            py::kw_only(), py::arg("min_range") = insertion.min_range,
            py::arg("max_range") = insertion.max_range,
            py::arg("insert_out_of_range") = insertion.insert_out_of_range,
            py::arg("model_negative_space") = insertion.model_negative_space,
            py::arg("insertion_threads") = insertion.insertion_threads,
-           py::arg("free_space_rays") = insertion.free_space_rays);
+           py::arg("free_space_rays") = insertion.free_space_rays,
+           py::arg("evidence_limit") = insertion.evidence_limit);
 
   const mvog::PlanningConfig planning;
   ConfigClass<mvog::PlanningConfig>(module, "PlanningConfig",
