@@ -25,6 +25,8 @@ MVOG_PACKAGES=(
   rviz tf2-tools liboctomap-dev octomap-tools
   xvfb xauth x11-utils libgl1-mesa-dri imagemagick valgrind
   clang-14 libclang-rt-14-dev clang-format-14 clang-tidy-14 catkin-lint shellcheck
+  # dynamic_reconfigure: its C++ server and macros, and the Python client (dynparam, the tests)
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
 )
 
 as_root() {

@@ -154,3 +154,9 @@ if(TARGET mvog_bench)
   endif()
   add_dependencies(test_mvog_bench mvog_bench)
 endif()
+
+# ---- dynamic_reconfigure on the server (cfg/MapperReconfigure.cfg, RuntimeReconfigure) ----------
+mvog_add_gtest(test_runtime_reconfigure
+  SOURCES test/ros/test_runtime_reconfigure.cpp
+  LIBRARIES mvog_ros)
+add_rostest(test/ros/reconfigure.test DEPENDENCIES mvog_node)

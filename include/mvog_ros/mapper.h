@@ -5,6 +5,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "mvog/map.h"
+#include "mvog_ros/decay.h"
 #include "mvog_ros/inputs/sensor_inputs.h"
 #include "mvog_ros/insertion_worker.h"
 #include "mvog_ros/local_window.h"
@@ -15,6 +16,7 @@
 #include "mvog_ros/publications/marker_publication.h"
 #include "mvog_ros/publications/planning_publication.h"
 #include "mvog_ros/publications/statistics_publication.h"
+#include "mvog_ros/runtime_reconfigure.h"
 #include "mvog_ros/services/map_edit_services.h"
 #include "mvog_ros/services/map_file_services.h"
 #include "mvog_ros/services/planning_services.h"
@@ -33,8 +35,9 @@ namespace mvog_ros {
 ///   services           queries, segment and box checks, map files and autosave, clear_box and
 ///                      merge_map, reset (services/)
 ///   local window       tiles far from the robot dropped and saved (LocalWindow)
-/// and decays the map itself, forgetting what decay made light. Callbacks may run on several
-/// threads at once.
+///   decay              decay and forgetting (Decay)
+///   reconfiguration    dynamic_reconfigure (RuntimeReconfigure), applied by reconfigure()
+/// Callbacks may run on several threads at once.
 class Mapper {
  public:
   /// Throws mvog::ConfigError naming the parameter at fault (~map_file if it cannot be loaded).
@@ -49,9 +52,10 @@ class Mapper {
   /// Puts `map` in place of the server's (~load_map, ~reset); the publications clear what they
   /// showed of the previous one at once.
   void replaceMap(mvog::Map&& map);
-  void decay(const ros::TimerEvent&);
+  /// Gives the parts the values in force (validated by RuntimeReconfigure), each under its lock.
+  void reconfigure(const MapperConfig& config);
 
-  const MapperConfig config_;
+  const MapperConfig config_;  // at start (RuntimeReconfigure holds the values in force)
   SharedMap map_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
@@ -69,10 +73,11 @@ class Mapper {
   MapFileServices map_files_;
   MapEditServices map_edits_;
   LocalWindow window_;
-  ros::Timer decay_timer_;
+  Decay decay_;
   SensorInputs inputs_;
   ResetService reset_;
   StatisticsPublication statistics_;
+  RuntimeReconfigure reconfigure_;
 };
 
 }  // namespace mvog_ros
