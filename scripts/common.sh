@@ -27,6 +27,8 @@ MVOG_PACKAGES=(
   clang-14 libclang-rt-14-dev clang-format-14 clang-tidy-14 catkin-lint shellcheck
   # dynamic_reconfigure: its C++ server and macros, and the Python client (dynparam, the tests)
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
+  # OMPL: mvog_ompl, the server's ~plan_path and mvog_ompl_bench (built when it is found)
+  libompl-dev
 )
 
 as_root() {

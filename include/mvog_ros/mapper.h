@@ -20,6 +20,9 @@
 #include "mvog_ros/services/map_edit_services.h"
 #include "mvog_ros/services/map_file_services.h"
 #include "mvog_ros/services/planning_services.h"
+#ifdef MVOG_HAVE_OMPL
+#include "mvog_ros/services/plan_path_service.h"
+#endif
 #include "mvog_ros/services/query_services.h"
 #include "mvog_ros/services/reset_service.h"
 #include "mvog_ros/shared_map.h"
@@ -33,7 +36,7 @@ namespace mvog_ros {
 ///   publications       markers, grids, frontiers and surfaces, binary map, map updates,
 ///                      statistics (publications/)
 ///   services           queries, segment and box checks, map files and autosave, clear_box and
-///                      merge_map, reset (services/)
+///                      merge_map, reset, plan_path with OMPL (services/)
 ///   local window       tiles far from the robot dropped and saved (LocalWindow)
 ///   decay              decay and forgetting (Decay)
 ///   reconfiguration    dynamic_reconfigure (RuntimeReconfigure), applied by reconfigure()
@@ -70,6 +73,9 @@ class Mapper {
   MapUpdatePublication map_updates_;
   QueryServices queries_;
   PlanningServices checks_;
+#ifdef MVOG_HAVE_OMPL
+  PlanPathService plan_path_;
+#endif
   MapFileServices map_files_;
   MapEditServices map_edits_;
   LocalWindow window_;

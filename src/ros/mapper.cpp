@@ -22,6 +22,9 @@ Mapper::Mapper(const ros::NodeHandle& nh, ros::NodeHandle private_nh)
       queries_(private_nh, config_.queries, config_.frame_id, config_.occupancy_threshold,
                config_.max_cross_section_cells, config_.map.max_coordinate, map_, tf_buffer_),
       checks_(private_nh, config_.queries, config_.planning, config_.frame_id, map_, tf_buffer_),
+#ifdef MVOG_HAVE_OMPL
+      plan_path_(private_nh, config_.queries, config_.planning, config_.frame_id, map_, tf_buffer_),
+#endif
       map_files_(private_nh, config_.map_files, map_,
                  [this](mvog::Map&& map) { replaceMap(std::move(map)); }),
       map_edits_(private_nh, config_.frame_id, config_.queries.tf_timeout,
@@ -79,6 +82,9 @@ void Mapper::reconfigure(const MapperConfig& config) {
   frontiers_and_surfaces_.reconfigure(publish_period, config.planning);
   queries_.setOccupancyThreshold(config.occupancy_threshold);
   checks_.setPlanning(config.planning);
+#ifdef MVOG_HAVE_OMPL
+  plan_path_.setPlanning(config.planning);
+#endif
   window_.reconfigure(config.lifetime.keep_radius, publish_period);
   decay_.reconfigure(config.decay, config.lifetime.forget_mass);
 }

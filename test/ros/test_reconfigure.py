@@ -50,9 +50,7 @@ class Reconfigure(unittest.TestCase):
     @classmethod
     def tearDownClass(cls):
         cls.client.close()
-        alive = cls.server.alive()
-        cls.server.stop()
-        assert alive, "the server died"
+        assert cls.server.stop_alive(), "the server died"
 
     def probability(self):
         response = self.server.occupancy([HIT])
