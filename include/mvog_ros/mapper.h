@@ -57,6 +57,8 @@ class Mapper {
   void replaceMap(mvog::Map&& map);
   /// Gives the parts the values in force (validated by RuntimeReconfigure), each under its lock.
   void reconfigure(const MapperConfig& config);
+  /// Where a depth image's +Inf pixels (no return) end with ~max_range `max_range`.
+  double depthNoReturnLength(double max_range) const;
 
   const MapperConfig config_;  // at start (RuntimeReconfigure holds the values in force)
   SharedMap map_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <mutex>
+#include <shared_mutex>
 #include <utility>
 
 namespace mvog_ros {
@@ -33,15 +34,11 @@ Mapper::Mapper(const ros::NodeHandle& nh, ros::NodeHandle private_nh)
               config_.publications.publish_period, map_, tf_buffer_,
               [this] { return insertion_.latestOrigin(); }),
       decay_(private_nh, config_.decay, config_.lifetime.forget_mass, map_),
-      // A depth image's +Inf pixels (no return) free their ray as far as the core would free any
-      // out-of-range reading: ~max_range, or the map's out_of_range_free_length if shorter.
-      inputs_(
-          nh, config_.inputs, config_.frame_id, config_.insertion.max_range,
-          std::min(config_.insertion.max_range, map_.map.config().rules.out_of_range_free_length),
-          tf_buffer_,
-          [this](mvog::Scan&& scan, const std::string& source) {
-            insertion_.enqueue(std::move(scan), source);
-          }),
+      inputs_(nh, config_.inputs, config_.frame_id, config_.insertion.max_range,
+              depthNoReturnLength(config_.insertion.max_range), tf_buffer_,
+              [this](mvog::Scan&& scan, const std::string& source) {
+                insertion_.enqueue(std::move(scan), source);
+              }),
       reset_(
           private_nh, map_, [this](mvog::Map&& map) { replaceMap(std::move(map)); },
           [this] {
@@ -75,6 +72,13 @@ void Mapper::replaceMap(mvog::Map&& map) {
   frontiers_and_surfaces_.restartIfReplaced();
 }
 
+double Mapper::depthNoReturnLength(double max_range) const {
+  // A depth image's +Inf pixels (no return) free their ray as far as the core would free any
+  // out-of-range reading: ~max_range, or the map's out_of_range_free_length if shorter.
+  std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
+  return std::min(max_range, map_.map.config().rules.out_of_range_free_length);
+}
+
 void Mapper::reconfigure(const MapperConfig& config) {
   const double publish_period = config.publications.publish_period;
   markers_.reconfigure(publish_period, config.occupancy_threshold);
@@ -86,6 +90,8 @@ void Mapper::reconfigure(const MapperConfig& config) {
   plan_path_.setPlanning(config.planning);
 #endif
   window_.reconfigure(config.lifetime.keep_radius, publish_period);
+  insertion_.setRanges(config.insertion.min_range, config.insertion.max_range);
+  inputs_.setMaxRange(config.insertion.max_range, depthNoReturnLength(config.insertion.max_range));
   decay_.reconfigure(config.decay, config.lifetime.forget_mass);
 }
 

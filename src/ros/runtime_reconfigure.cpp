@@ -51,7 +51,7 @@ bool sameValues(const mvog::MapperReconfigureConfig& a, const mvog::MapperReconf
          a.decay_period == b.decay_period && a.forget_mass == b.forget_mass &&
          a.publish_period == b.publish_period &&
          a.cross_section_heights_text == b.cross_section_heights_text &&
-         a.keep_radius == b.keep_radius;
+         a.keep_radius == b.keep_radius && a.min_range == b.min_range && a.max_range == b.max_range;
 }
 
 }  // namespace
@@ -65,6 +65,8 @@ mvog::MapperReconfigureConfig reconfigurableValuesOf(const MapperConfig& config)
   values.publish_period = config.publications.publish_period;
   values.cross_section_heights_text = heightsText(config.publications.cross_section_heights);
   values.keep_radius = config.lifetime.keep_radius;
+  values.min_range = config.insertion.min_range;
+  values.max_range = config.insertion.max_range;
   return values;
 }
 
@@ -80,6 +82,8 @@ MapperConfig withReconfiguredValues(const MapperConfig& current,
   config.publications.cross_section_heights = heightsFromText(
       values.cross_section_heights_text, current.publications.cross_section_heights.size());
   config.lifetime.keep_radius = values.keep_radius;
+  config.insertion.min_range = values.min_range;
+  config.insertion.max_range = values.max_range;
   config.validate();
   return config;
 }
@@ -90,6 +94,7 @@ RuntimeReconfigure::RuntimeReconfigure(const ros::NodeHandle& private_nh,
   // The server starts from the parameter server or the .cfg's defaults: it reports the values
   // in force instead, then calls reconfigure() with them (nothing to apply).
   server_.updateConfig(reconfigurableValuesOf(config_));
+  server_.setConfigDefault(reconfigurableValuesOf(config_));
   server_.setCallback([this](mvog::MapperReconfigureConfig& values, std::uint32_t level) {
     reconfigure(values, level);
   });
@@ -110,11 +115,12 @@ void RuntimeReconfigure::reconfigure(mvog::MapperReconfigureConfig& values, std:
   values = reconfigurableValuesOf(config_);  // the heights as the server reads them
   ROS_INFO(
       "mvog: dynamic_reconfigure: occupancy_threshold %g, decay_factor %g, decay_period %g "
-      "s, forget_mass %g, publish_period %g s, cross_section_heights [%s], keep_radius %g m",
+      "s, forget_mass %g, publish_period %g s, cross_section_heights [%s], keep_radius %g m, "
+      "min_range %g m, max_range %g m",
       config_.occupancy_threshold, config_.decay.decay_factor, config_.decay.decay_period,
       config_.lifetime.forget_mass, config_.publications.publish_period,
-      heightsText(config_.publications.cross_section_heights).c_str(),
-      config_.lifetime.keep_radius);
+      heightsText(config_.publications.cross_section_heights).c_str(), config_.lifetime.keep_radius,
+      config_.insertion.min_range, config_.insertion.max_range);
 }
 
 }  // namespace mvog_ros

@@ -111,6 +111,22 @@ class Reconfigure(unittest.TestCase):
         self.assertEqual(self.probability()[1], life.FREE)
         self.assertTrue(self.server.alive())
 
+    def test_4_max_range_changes_and_the_next_scan_follows(self):
+        angle = 1.0  # rad: a beam of its own, away from the cell of the other tests
+        along = lambda distance: (distance * math.cos(angle), distance * math.sin(angle),  # noqa
+                                  rel.LASER_HEIGHT)
+        self.refused({"max_range": 0.0}, "max_range", "must be")
+        self.refused({"min_range": 2.0, "max_range": 1.5}, "min_range",
+                     "must be smaller than max_range")
+        reported = self.client.update_configuration({"max_range": 1.5})
+        self.assertEqual(reported["max_range"], 1.5)
+        inserted = self.server.stats().messages_inserted
+        self.server.scans.publish(rel.scan([2.5], angle_min=angle, angle_increment=0.1))
+        self.server.wait_counter("messages_inserted", inserted + 1)
+        # The hit at 2.5 m lies beyond ~max_range: free space up to 1.5 m, nothing beyond.
+        states = self.server.occupancy([along(1.0), along(2.5)]).state
+        self.assertEqual(list(states), [life.FREE, life.UNKNOWN])
+
     def test_3_a_new_cross_section_height_moves_its_grid(self):
         rel.wait_for(lambda: self.cross_section.grid is not None, "~cross_section_0")
         self.assertAlmostEqual(self.cross_section.grid.info.origin.position.z, 0.5)

@@ -49,6 +49,8 @@ TEST(RuntimeReconfigure, NewValuesReachEveryPartsSlice) {
   values.publish_period = 0.25;
   values.cross_section_heights_text = " -0.5 ,2";
   values.keep_radius = 7.5;
+  values.min_range = 0.3;
+  values.max_range = 6.0;
   const MapperConfig config = withReconfiguredValues(startConfig(), values);
   EXPECT_EQ(config.occupancy_threshold, 0.4);
   // The planners' threshold is the server's.
@@ -59,6 +61,8 @@ TEST(RuntimeReconfigure, NewValuesReachEveryPartsSlice) {
   EXPECT_EQ(config.publications.publish_period, 0.25);
   EXPECT_EQ(config.publications.cross_section_heights, (std::vector<double>{-0.5, 2.0}));
   EXPECT_EQ(config.lifetime.keep_radius, 7.5);
+  EXPECT_EQ(config.insertion.min_range, 0.3);
+  EXPECT_EQ(config.insertion.max_range, 6.0);
 }
 
 TEST(RuntimeReconfigure, BadValuesAreRefusedNamingTheirParameter) {
@@ -74,6 +78,9 @@ TEST(RuntimeReconfigure, BadValuesAreRefusedNamingTheirParameter) {
       {"forget_mass", [](auto& v) { v.forget_mass = 0.1; }},  // without decay
       {"publish_period", [](auto& v) { v.publish_period = 0.0; }},
       {"keep_radius", [](auto& v) { v.keep_radius = -1.0; }},
+      {"min_range", [](auto& v) { v.min_range = -0.5; }},
+      {"max_range", [](auto& v) { v.max_range = 0.0; }},
+      {"min_range", [](auto& v) { v.min_range = 5.0, v.max_range = 4.0; }},
       {"cross_section_heights", [](auto& v) { v.cross_section_heights_text = "0.5, 1e9"; }},
       {"cross_section_heights_text", [](auto& v) { v.cross_section_heights_text = "0.5"; }},
       {"cross_section_heights_text", [](auto& v) { v.cross_section_heights_text = "0.5 1 2"; }},
