@@ -3,19 +3,22 @@
 // "Planning with OMPL"). ROS-free. Usage:
 //   mvog_ompl_bench [--map FILE | --graph FILE [--resolution R]] [--start X,Y,Z --goal X,Y,Z]
 //                   [--radius R] [--edges N] [--plans N] [--time-limit S] [--allow-unknown]
-//                   [--print-path] [--seed N]
+//                   [--print-path] [--close-box X0,Y0,Z0,X1,Y1,Z1] [--seed N]
 // Without --map: the office of the demo (mvog_scene::officeScene) split by a wall at x = 3.0-3.1
 // with a door (y in [-0.5, 0.5], z up to 2.0), mapped at 0.05 m by a rotating lidar and a tilting
 // laser from poses on both sides; then again with the door closed by a box, where no path may be
 // found. With --map: a saved map (e.g. a recording replayed through the server, ~save_map); with
 // --graph: an OctoMap scan graph of $MVOG_DATA_DIR (kurt3d_3scans.graph) mapped at --resolution
-// (default 0.1 m) from its hits; each with the start and goal to plan between.
+// (default 0.1 m) from its hits; each with the start and goal to plan between. --close-box: plans
+// a second time in the map with the box made occupied space (the columns over its cells replaced
+// by one occupied volume over its heights: a door closed).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -47,7 +50,8 @@ struct Options {
   int plans = 20;
   double time_limit = 1.0;
   bool allow_unknown = false;
-  bool print_path = false;  // the first path's waypoints, to see where it passes
+  bool print_path = false;             // the first path's waypoints, to see where it passes
+  std::optional<mvog::Box> close_box;  // made occupied for a second plan (--map, --graph)
   unsigned seed = 1;
 };
 
@@ -105,6 +109,31 @@ Eigen::Vector3d parsePoint(const char* text) {
     throw std::invalid_argument(std::string("not a point X,Y,Z: ") + text);
   }
   return point;
+}
+
+mvog::Box parseBox(const char* text) {
+  mvog::Box box;
+  if (std::sscanf(text, "%lf,%lf,%lf,%lf,%lf,%lf", &box.min.x(), &box.min.y(), &box.min.z(),
+                  &box.max.x(), &box.max.y(), &box.max.z()) != 6 ||
+      (box.min.array() > box.max.array()).any()) {
+    throw std::invalid_argument(std::string("not a box X0,Y0,Z0,X1,Y1,Z1 (min, max): ") + text);
+  }
+  return box;
+}
+
+/// `map` with the columns over `box`'s cells replaced by one occupied volume over its heights.
+void makeOccupied(mvog::Map& map, const mvog::Box& box) {
+  const mvog::CellRange cells =
+      map.cellsInRectangle(box.min.x(), box.min.y(), box.max.x(), box.max.y());
+  const auto bottom = static_cast<float>(box.min.z() / map.resolution());
+  const auto top = static_cast<float>(box.max.z() / map.resolution());
+  std::vector<mvog::Map::CellAssignment> columns;
+  for (int y = cells.min.y; y <= cells.max.y; ++y) {
+    for (int x = cells.min.x; x <= cells.max.x; ++x) {
+      columns.push_back({{x, y}, {{{bottom, top, top - bottom}}, {}}});
+    }
+  }
+  map.setCellVolumes(columns);
 }
 
 double median(std::vector<double> values) {
@@ -277,6 +306,8 @@ int main(int argc, char** argv) {
         options.plans = std::max(1, std::atoi(argv[++k]));
       } else if (arg == "--time-limit" && has_value) {
         options.time_limit = std::atof(argv[++k]);
+      } else if (arg == "--close-box" && has_value) {
+        options.close_box = parseBox(argv[++k]);
       } else if (arg == "--print-path") {
         options.print_path = true;
       } else if (arg == "--allow-unknown") {
@@ -284,11 +315,12 @@ int main(int argc, char** argv) {
       } else if (arg == "--seed" && has_value) {
         options.seed = static_cast<unsigned>(std::atoi(argv[++k]));
       } else {
-        std::fprintf(stderr,
-                     "usage: %s [--map FILE | --graph FILE [--resolution R]] [--start X,Y,Z "
-                     "--goal X,Y,Z] [--radius R] [--edges N] [--plans N] [--time-limit S] "
-                     "[--allow-unknown] [--print-path] [--seed N]\n",
-                     argv[0]);
+        std::fprintf(
+            stderr,
+            "usage: %s [--map FILE | --graph FILE [--resolution R]] [--start X,Y,Z "
+            "--goal X,Y,Z] [--radius R] [--edges N] [--plans N] [--time-limit S] "
+            "[--allow-unknown] [--print-path] [--close-box X0,Y0,Z0,X1,Y1,Z1] [--seed N]\n",
+            argv[0]);
         return arg == "--help" || arg == "-h" ? 0 : 2;
       }
     }
@@ -310,6 +342,12 @@ int main(int argc, char** argv) {
         "|---|---:|---:|---:|---:|---:|---:|---|\n");
     plan(map, options, source.empty() ? "door open" : source.c_str());
     if (source.empty()) plan(mapOf(officeWithDoor(true)), options, "door closed");
+    if (!source.empty() && options.close_box) {
+      mvog::Map closed =
+          !options.map_file.empty() ? mvog::loadMap(options.map_file) : graphMap(options);
+      makeOccupied(closed, *options.close_box);
+      plan(closed, options, "the box closed");
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mvog_ompl_bench: %s\n", e.what());
     return 1;
