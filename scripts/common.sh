@@ -28,6 +28,10 @@ MVOG_PACKAGES=(
   # The Python module (src/python): pybind11 to build it, pytest for test/python, matplotlib for
   # the example scripts/python_map_views.py.
   pybind11-dev python3-dev python3-pytest python3-matplotlib
+  # dynamic_reconfigure: its C++ server and macros, and the Python client (dynparam, the tests)
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
+  # OMPL: mvog_ompl, the server's ~plan_path and mvog_ompl_bench (built when it is found)
+  libompl-dev
 )
 
 as_root() {

@@ -137,6 +137,19 @@ rosservice call /mvog_mapper/save_map "path: 'demo.mvog'" >"$LOG_DIR/demo-save.l
 grep -q 'success: True' "$LOG_DIR/demo-save.log" || { cat "$LOG_DIR/demo-save.log"; exit 1; }
 map=$output/demo.mvog
 
+# A path through the door (~plan_path, when the server is built with OMPL), from the room into
+# the corridor of the embedded recording: on ~planned_path (latched) for rviz's screenshot.
+plan_status=""
+if [ "$bag" = "$output/scene.bag" ] && rosservice list 2>/dev/null | grep -q /mvog_mapper/plan_path; then
+  rosservice call /mvog_mapper/plan_path "{frame_id: '', start: {x: 4.0, y: 1.5, z: 1.2},
+    goal: {x: 6.5, y: -1.0, z: 1.0}, radius: 0.25, time_limit: 1.0, allow_unknown: false}" \
+    >"$LOG_DIR/demo-plan.log"
+  plan_status="status $(sed -n 's/^status: //p' "$LOG_DIR/demo-plan.log") (0: planned)"
+  plan_status+=", $(grep -c 'position:' "$LOG_DIR/demo-plan.log" || true) waypoints,"
+  plan_status+=" $(sed -n 's/^planning_time: //p' "$LOG_DIR/demo-plan.log") s"
+  plan_status+=" $(sed -n "s/^message: //p" "$LOG_DIR/demo-plan.log" | grep -v "^''$" || true)"
+fi
+
 export_args=()
 for z in "${height_list[@]}"; do export_args+=(--cross-section "$z" "$output/cross_section_${z}m"); done
 export_args+=(--projection 0.1 2.0 "$output/projected_map" --render "$output/occupied.png")
@@ -240,6 +253,8 @@ found = [states.get(s.strip(), s) for s in line.split(":", 1)[1].strip(" []").sp
 print("  where the person stood, after he left: " + ", ".join(found))
 PY
 fi
+[ -n "$plan_status" ] &&
+  echo "path through the door, (4.0, 1.5, 1.2) to (6.5, -1.0, 1.0), radius 0.25 m: $plan_status"
 echo
 echo "wrote:"
 echo "  map             $map"

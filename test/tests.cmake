@@ -155,3 +155,17 @@ if(TARGET mvog_bench)
   endif()
   add_dependencies(test_mvog_bench mvog_bench)
 endif()
+
+# ---- dynamic_reconfigure on the server (cfg/MapperReconfigure.cfg, RuntimeReconfigure) ----------
+mvog_add_gtest(test_runtime_reconfigure
+  SOURCES test/ros/test_runtime_reconfigure.cpp
+  LIBRARIES mvog_ros)
+add_rostest(test/ros/reconfigure.test DEPENDENCIES mvog_node)
+
+# ---- mvog_ompl: OMPL on an mvog::Map, built when OMPL is found ----------------------------------
+if(TARGET mvog_ompl)
+  mvog_add_gtest(test_mvog_ompl
+    SOURCES test/ompl/test_map_validity.cpp
+    LIBRARIES mvog_ompl)
+  add_rostest(test/ros/plan_path.test DEPENDENCIES mvog_node)
+endif()

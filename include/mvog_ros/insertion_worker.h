@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "mvog/map.h"
 #include "mvog/scan_update.h"
@@ -44,6 +45,9 @@ class InsertionWorker {
 
   /// Queues `scan` for insertion; `source` (its message type) names it in warnings.
   void enqueue(mvog::Scan&& scan, const std::string& source);
+  /// ~min_range and ~max_range changed (RuntimeReconfigure, validated already): the next scan
+  /// inserted uses them.
+  void setRanges(double min_range, double max_range);
   /// Inserts what is queued, then ends the thread: nothing enqueued afterwards is inserted.
   void stop();
 
@@ -63,7 +67,9 @@ class InsertionWorker {
   /// and applied under its write lock; with ~backlog_insertion_threads if `backlog`.
   mvog::InsertionResult insert(const mvog::Scan& scan, bool backlog);
 
-  const InsertionWorkerConfig config_;
+  const InsertionWorkerConfig config_;  // its ranges: those at start (ranges_ follows)
+  mutable std::mutex ranges_mutex_;
+  std::pair<double, double> ranges_;  // min_range, max_range (under ranges_mutex_)
   SharedMap& map_;
   mvog::ScanUpdate update_;  // its buffers and threads, kept from scan to scan
 

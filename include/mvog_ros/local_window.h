@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -31,6 +32,9 @@ class LocalWindow {
               SharedMap& shared_map, const tf2_ros::Buffer& tf_buffer,
               LatestScanOrigin latest_scan_origin);
 
+  /// Validated already: the next look drops the tiles farther than `keep_radius` (0: none), every
+  /// `period` s from then on.
+  void reconfigure(double keep_radius, double period);
   /// Stops dropping tiles, and writes those not written yet (a clean shutdown loses none).
   void stop();
 
@@ -41,7 +45,8 @@ class LocalWindow {
   /// save_mutex_).
   void writeUnsaved();
 
-  const LifetimeConfig config_;
+  const LifetimeConfig config_;  // its keep_radius: the one at start (keep_radius_ follows)
+  std::atomic<double> keep_radius_;
   const std::string frame_id_;
   const std::string save_path_;  // empty: dropped tiles are discarded
   SharedMap& map_;

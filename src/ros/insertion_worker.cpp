@@ -4,6 +4,7 @@
 #include <chrono>
 #include <mutex>
 #include <shared_mutex>
+#include <tuple>
 #include <utility>
 
 #include <ros/console.h>
@@ -19,7 +20,15 @@ constexpr std::size_t kMinReadingsForBacklogThreads = 10000;
 }  // namespace
 
 InsertionWorker::InsertionWorker(const InsertionWorkerConfig& config, SharedMap& shared_map)
-    : config_(config), map_(shared_map), thread_(&InsertionWorker::run, this) {}
+    : config_(config),
+      ranges_(config.min_range, config.max_range),
+      map_(shared_map),
+      thread_(&InsertionWorker::run, this) {}
+
+void InsertionWorker::setRanges(double min_range, double max_range) {
+  std::lock_guard<std::mutex> lock(ranges_mutex_);
+  ranges_ = {min_range, max_range};
+}
 
 InsertionWorker::~InsertionWorker() { stop(); }
 
@@ -92,6 +101,10 @@ mvog::InsertionResult InsertionWorker::insert(const mvog::Scan& scan, bool backl
   // nothing of the map but its configuration: it runs outside the lock, which queries and
   // publications then wait for only while the scan's columns are merged.
   mvog::InsertionConfig insertion = config_;
+  {
+    std::lock_guard<std::mutex> lock(ranges_mutex_);
+    std::tie(insertion.min_range, insertion.max_range) = ranges_;
+  }
   if (backlog) {
     insertion.insertion_threads =
         std::max(insertion.insertion_threads, config_.backlog_insertion_threads);

@@ -26,18 +26,25 @@ LocalWindow::LocalWindow(ros::NodeHandle& private_nh, const LifetimeConfig& conf
                          double period, SharedMap& shared_map, const tf2_ros::Buffer& tf_buffer,
                          LatestScanOrigin latest_scan_origin)
     : config_(config),
+      keep_radius_(config.keep_radius),
       frame_id_(frame_id),
       save_path_(savePath(config, map_directory)),
       map_(shared_map),
       tf_buffer_(tf_buffer),
       latest_scan_origin_(std::move(latest_scan_origin)) {
-  if (config_.keep_radius == 0.0) return;
+  // Running even with ~keep_radius 0 (nothing dropped), which reconfigure() may change.
   timer_ = private_nh.createTimer(ros::Duration(period), &LocalWindow::dropFarTiles, this);
+  if (config_.keep_radius == 0.0) return;
   const std::string centre =
       config_.robot_frame.empty() ? "the latest scan's origin" : "'" + config_.robot_frame + "'";
   const std::string where = save_path_.empty() ? "are discarded" : "go into '" + save_path_ + "'";
   ROS_INFO("mvog: keeping the map within %.1f m of %s; tiles farther %s", config_.keep_radius,
            centre.c_str(), where.c_str());
+}
+
+void LocalWindow::reconfigure(double keep_radius, double period) {
+  keep_radius_ = keep_radius;
+  timer_.setPeriod(ros::Duration(period));
 }
 
 void LocalWindow::stop() {
@@ -61,12 +68,14 @@ std::optional<Eigen::Vector2d> LocalWindow::robotPosition() const {
 }
 
 void LocalWindow::dropFarTiles(const ros::TimerEvent&) {
+  const double keep_radius = keep_radius_;
+  if (keep_radius == 0.0) return;
   const std::optional<Eigen::Vector2d> centre = robotPosition();
   if (!centre) return;
   mvog::Map dropped;
   try {
     std::unique_lock<WriterPreferringMutex> lock(map_.mutex);
-    dropped = map_.map.dropTilesFartherThan(*centre, config_.keep_radius);
+    dropped = map_.map.dropTilesFartherThan(*centre, keep_radius);
   } catch (const mvog::ConfigError& e) {  // a centre that is not finite
     ROS_WARN_THROTTLE(kWarningPeriod, "mvog: ~keep_radius: no tiles dropped: %s", e.what());
     return;

@@ -290,6 +290,12 @@ class Server:
         if self.own_directory:
             shutil.rmtree(self.directory, ignore_errors=True)
 
+    def stop_alive(self):
+        """Stops the server; returns whether it was still running until then."""
+        alive = self.alive()
+        self.stop()
+        return alive
+
     def kill(self):
         """SIGKILL: no shutdown, no cleanup."""
         self.process.kill()

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <deque>
 #include <mutex>
 #include <string>
@@ -26,6 +27,8 @@ class DepthImageInput : public SensorInput {
   ~DepthImageInput() override;
 
   void stop() override;
+  /// ~max_range changed (RuntimeReconfigure): the next image converted uses `no_return_length`.
+  void setNoReturnLength(double no_return_length) { no_return_length_ = no_return_length; }
 
   /// Converts `image` with its camera info and the camera's pose and enqueues it; an invalid
   /// pair is dropped, counted.
@@ -40,7 +43,8 @@ class DepthImageInput : public SensorInput {
   void receivePair(const sensor_msgs::ImageConstPtr& image,
                    const sensor_msgs::CameraInfoConstPtr& camera_info);
 
-  const mvog::DepthImageConfig config_;
+  const int stride_;                      // ~depth_stride
+  std::atomic<double> no_return_length_;  // DepthImageConfig's, read once per image
   std::mutex pairing_mutex_;
   // Up to ~sensor_queue_size each, oldest first: images waiting for the camera info of their
   // stamp (the oldest is dropped and counted beyond), and the latest camera infos.

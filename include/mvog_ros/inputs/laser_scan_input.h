@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <string>
 
 #include <sensor_msgs/LaserScan.h>
@@ -17,12 +18,15 @@ class LaserScanInput : public SensorInput {
                  double max_range);
   ~LaserScanInput() override;
 
+  /// ~max_range changed (RuntimeReconfigure): the next scan converted uses it.
+  void setMaxRange(double max_range) { max_range_ = max_range; }
+
   /// Converts `scan` with the sensor's pose and enqueues it; an invalid scan is dropped, counted.
   void convertAndEnqueue(const sensor_msgs::LaserScan& scan,
                          const Eigen::Isometry3d& map_from_sensor);
 
  private:
-  const double max_range_;
+  std::atomic<double> max_range_;  // read once per scan
 };
 
 }  // namespace mvog_ros

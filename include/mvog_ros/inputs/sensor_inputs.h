@@ -8,6 +8,9 @@
 
 namespace mvog_ros {
 
+class LaserScanInput;
+class DepthImageInput;
+
 /// The server's sensor inputs: a LaserScanInput for `scan` and each of ~scan_topics, a
 /// PointCloudInput for `cloud_in` and each of ~cloud_topics, a DepthImageInput for each of
 /// ~depth_topics (topics relative to `nh`), and the counts of what they dropped.
@@ -19,6 +22,9 @@ class SensorInputs {
                double max_range, double depth_no_return_length, const tf2_ros::Buffer& tf_buffer,
                EnqueueScan enqueue);
 
+  /// ~max_range changed (RuntimeReconfigure): as the constructor's arguments, for the next
+  /// message each input converts.
+  void setMaxRange(double max_range, double depth_no_return_length);
   /// Every input stops taking messages (SensorInput::stop).
   void stop();
 
@@ -28,6 +34,9 @@ class SensorInputs {
  private:
   InputCounters counters_;
   std::vector<std::unique_ptr<SensorInput>> inputs_;
+  // Those of inputs_ that convert with ~max_range.
+  std::vector<LaserScanInput*> scan_inputs_;
+  std::vector<DepthImageInput*> depth_inputs_;
 };
 
 }  // namespace mvog_ros

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <vector>
@@ -38,6 +39,10 @@ class ChangePublication {
   explicit ChangePublication(const SharedMap& shared_map);
   /// Starts publishing every `period` s: the last step of a derived constructor.
   void start(ros::NodeHandle& private_nh, double period);
+  /// Runs `change` (new values for the derived class's state) under mutex_ and the map's lock,
+  /// publishes everything afresh with them at once (what was shown followed the old values),
+  /// and from then on every `period` s (dynamic_reconfigure: RuntimeReconfigure).
+  void reconfigure(double period, const std::function<void()>& change);
   /// Stops publishing: the first step of a derived destructor (the timer calls the derived
   /// class).
   void stop();

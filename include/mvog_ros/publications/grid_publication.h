@@ -30,6 +30,11 @@ class GridPublication : public ChangePublication {
                   const SharedMap& shared_map);
   ~GridPublication() override;
 
+  /// New values, validated already (as many cross-section heights as at start): every grid is
+  /// computed and published afresh with them at once.
+  void reconfigure(const PublicationsConfig& config, const mvog::PlanningConfig& planning,
+                   double occupancy_threshold);
+
  private:
   /// One grid: the projected map, or one cross-section.
   struct Layer {

@@ -22,13 +22,16 @@ class MarkerPublication : public ChangePublication {
                     const SharedMap& shared_map);
   ~MarkerPublication() override;
 
+  /// New values, validated already: the markers are published afresh with them at once.
+  void reconfigure(double publish_period, double occupancy_threshold);
+
  private:
   void clearPublished() override;
   void publishTiles(const std::vector<mvog::TileIndex>& changed) override;
   void sendAll(const ros::SingleSubscriberPublisher& subscriber, bool occupied_only);
 
   const std::string frame_id_;
-  const double occupancy_threshold_;
+  double occupancy_threshold_;  // under mutex_
   ros::Publisher volumes_publisher_;
   ros::Publisher occupied_publisher_;
 };

@@ -28,6 +28,10 @@ class PlanningPublication : public ChangePublication {
                       const SharedMap& shared_map);
   ~PlanningPublication() override;
 
+  /// New values, validated already (the occupancy threshold): the frontiers and surfaces are
+  /// recomputed and published afresh at once.
+  void reconfigure(double publish_period, const mvog::PlanningConfig& planning);
+
  private:
   enum class Output { kFrontiers, kFrontierMarkers, kSurfaces };
 

@@ -30,6 +30,9 @@ class PlanningServices {
                    const mvog::PlanningConfig& planning, const std::string& frame_id,
                    const SharedMap& shared_map, const tf2_ros::Buffer& tf_buffer);
 
+  /// Validated already (a new occupancy threshold): the next request uses it.
+  void setPlanning(const mvog::PlanningConfig& planning);
+
  private:
   bool checkSegments(mvog::CheckSegments::Request& request,
                      mvog::CheckSegments::Response& response);
@@ -42,7 +45,7 @@ class PlanningServices {
                                                  const char* lists, std::string& refusal) const;
 
   const QueryServicesConfig config_;
-  const mvog::PlanningConfig planning_;
+  mvog::PlanningConfig planning_;  // under checker_mutex_
   const std::string frame_id_;
   const SharedMap& map_;
   const tf2_ros::Buffer& tf_buffer_;

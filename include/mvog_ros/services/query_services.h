@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <string>
 
 #include <ros/ros.h>
@@ -22,6 +23,9 @@ class QueryServices {
                 int max_cross_section_cells, double max_coordinate, const SharedMap& shared_map,
                 const tf2_ros::Buffer& tf_buffer);
 
+  /// Validated already: the next request uses it.
+  void setOccupancyThreshold(double occupancy_threshold);
+
  private:
   bool getOccupancy(mvog::GetOccupancy::Request& request, mvog::GetOccupancy::Response& response);
   bool getCrossSection(mvog::GetCrossSection::Request& request,
@@ -29,7 +33,7 @@ class QueryServices {
 
   const QueryServicesConfig config_;
   const std::string frame_id_;
-  const double occupancy_threshold_;
+  std::atomic<double> occupancy_threshold_;  // read once per request
   const int max_cross_section_cells_;
   const double max_coordinate_;  // ~max_coordinate: no rectangle beyond it is cut
   const SharedMap& map_;

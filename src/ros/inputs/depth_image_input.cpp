@@ -12,7 +12,8 @@ namespace mvog_ros {
 DepthImageInput::DepthImageInput(ros::NodeHandle& nh, const std::string& topic,
                                  const SensorInputContext& context, double no_return_length)
     : SensorInput(nh, context),
-      config_{context.config.depth_stride, no_return_length},
+      stride_(context.config.depth_stride),
+      no_return_length_(no_return_length),
       image_transport_(nh) {
   const auto queue_size = static_cast<std::uint32_t>(context.config.sensor_queue_size);
   image_subscriber_ =
@@ -90,7 +91,8 @@ void DepthImageInput::convertAndEnqueue(const sensor_msgs::Image& image,
                                         const sensor_msgs::CameraInfo& camera_info,
                                         const Eigen::Isometry3d& map_from_camera) {
   enqueueConverted("depth image", [&](std::size_t& skipped) {
-    return depthImageToScan(image, camera_info, map_from_camera, config_,
+    const mvog::DepthImageConfig config{stride_, no_return_length_.load()};
+    return depthImageToScan(image, camera_info, map_from_camera, config,
                             static_cast<std::size_t>(context_.config.max_points_per_message),
                             skipped);
   });

@@ -15,7 +15,7 @@ LaserScanInput::~LaserScanInput() { stop(); }
 void LaserScanInput::convertAndEnqueue(const sensor_msgs::LaserScan& scan,
                                        const Eigen::Isometry3d& map_from_sensor) {
   enqueueConverted("LaserScan", [&](std::size_t& skipped) {
-    return laserScanToScan(scan, map_from_sensor, max_range_,
+    return laserScanToScan(scan, map_from_sensor, max_range_.load(),
                            static_cast<std::size_t>(context_.config.max_points_per_message),
                            skipped);
   });

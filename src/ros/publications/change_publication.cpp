@@ -31,6 +31,19 @@ void ChangePublication::start(ros::NodeHandle& private_nh, double period) {
 
 void ChangePublication::stop() { timer_.stop(); }
 
+void ChangePublication::reconfigure(double period, const std::function<void()>& change) {
+  {
+    std::lock_guard<std::mutex> publication_lock(mutex_);
+    std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
+    change();
+    clearPublished();
+    published_ = {map_.generation, 0};
+    publishChangesLocked();
+  }
+  // Outside the locks: the timer's callback takes them.
+  timer_.setPeriod(ros::Duration(period));
+}
+
 void ChangePublication::restartIfReplaced() {
   std::lock_guard<std::mutex> publication_lock(mutex_);
   std::shared_lock<WriterPreferringMutex> lock(map_.mutex);

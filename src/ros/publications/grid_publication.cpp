@@ -11,18 +11,16 @@
 
 namespace mvog_ros {
 
-GridPublication::GridPublication(ros::NodeHandle& private_nh, const PublicationsConfig& config,
-                                 const mvog::PlanningConfig& planning, const std::string& frame_id,
-                                 double occupancy_threshold, int max_cross_section_cells,
-                                 const SharedMap& shared_map)
-    : ChangePublication(shared_map),
-      frame_id_(frame_id),
-      max_cross_section_cells_(max_cross_section_cells) {
+namespace {
+
+/// The grids GridPublication keeps, in the order of its layers: the projected map, one per
+/// cross-section height, the traversable map.
+std::vector<IncrementalGrid> makeGrids(const PublicationsConfig& config,
+                                       const mvog::PlanningConfig& planning,
+                                       double occupancy_threshold, int max_cross_section_cells) {
   const double min_z = config.projection_min_z;
   const double max_z = config.projection_max_z;
   std::vector<IncrementalGrid> grids;
-  std::vector<std::string> topics;
-  std::vector<bool> reads_neighbours;
   grids.emplace_back(
       min_z, max_cross_section_cells,
       [min_z, max_z, occupancy_threshold](const mvog::Map& map, const mvog::CellRange& cells) {
@@ -30,18 +28,12 @@ GridPublication::GridPublication(ros::NodeHandle& private_nh, const Publications
                                ros::Time())
             .data;
       });
-  topics.push_back("projected_map");
-  reads_neighbours.push_back(false);
-  for (std::size_t k = 0; k < config.cross_section_heights.size(); ++k) {
-    const double height = config.cross_section_heights[k];
+  for (const double height : config.cross_section_heights) {
     grids.emplace_back(
         height, max_cross_section_cells,
         [height](const mvog::Map& map, const mvog::CellRange& cells) {
           return toOccupancyGrid(map.crossSection(height, cells), height, "", ros::Time()).data;
         });
-    topics.push_back("cross_section_" + std::to_string(k));
-    reads_neighbours.push_back(false);
-    ROS_INFO("mvog: ~%s is the cross-section at z = %.3f m", topics.back().c_str(), height);
   }
   // Drawn at the height of the band nearest z = 0, the ground of a map frame by REP-105.
   grids.emplace_back(std::clamp(0.0, planning.traversable_min_z, planning.traversable_max_z),
@@ -49,14 +41,33 @@ GridPublication::GridPublication(ros::NodeHandle& private_nh, const Publications
                      [planning](const mvog::Map& map, const mvog::CellRange& cells) {
                        return traversableGridData(map, cells, planning);
                      });
+  return grids;
+}
+
+}  // namespace
+
+GridPublication::GridPublication(ros::NodeHandle& private_nh, const PublicationsConfig& config,
+                                 const mvog::PlanningConfig& planning, const std::string& frame_id,
+                                 double occupancy_threshold, int max_cross_section_cells,
+                                 const SharedMap& shared_map)
+    : ChangePublication(shared_map),
+      frame_id_(frame_id),
+      max_cross_section_cells_(max_cross_section_cells) {
+  std::vector<IncrementalGrid> grids =
+      makeGrids(config, planning, occupancy_threshold, max_cross_section_cells);
+  std::vector<std::string> topics{"projected_map"};
+  for (std::size_t k = 0; k < config.cross_section_heights.size(); ++k) {
+    topics.push_back("cross_section_" + std::to_string(k));
+    ROS_INFO("mvog: ~%s is the cross-section at z = %.3f m", topics.back().c_str(),
+             config.cross_section_heights[k]);
+  }
   topics.push_back("traversable_map");
-  reads_neighbours.push_back(true);
   // A subscriber's connection callback may run on another thread as soon as its topic is
   // advertised: it waits for the layers to be complete.
   std::lock_guard<std::mutex> publication_lock(mutex_);
   for (std::size_t k = 0; k < grids.size(); ++k) {
-    layers_.push_back(
-        {std::move(grids[k]), reads_neighbours[k], ros::Publisher(), ros::Publisher()});
+    const bool reads_neighbours = k + 1 == grids.size();  // the traversable map
+    layers_.push_back({std::move(grids[k]), reads_neighbours, ros::Publisher(), ros::Publisher()});
     layers_[k].publisher = private_nh.advertise<nav_msgs::OccupancyGrid>(
         topics[k], 1,
         [this, k](const ros::SingleSubscriberPublisher& subscriber) { send(subscriber, k); },
@@ -65,6 +76,21 @@ GridPublication::GridPublication(ros::NodeHandle& private_nh, const Publications
         private_nh.advertise<map_msgs::OccupancyGridUpdate>(topics[k] + "_updates", 10);
   }
   start(private_nh, config.publish_period);
+}
+
+void GridPublication::reconfigure(const PublicationsConfig& config,
+                                  const mvog::PlanningConfig& planning,
+                                  double occupancy_threshold) {
+  std::vector<IncrementalGrid> grids =
+      makeGrids(config, planning, occupancy_threshold, max_cross_section_cells_);
+  ChangePublication::reconfigure(config.publish_period, [&] {
+    // As many grids as layers: the number of cross-sections (their topics) is start-only.
+    for (std::size_t k = 0; k < layers_.size(); ++k) layers_[k].grid = std::move(grids.at(k));
+  });
+  for (std::size_t k = 0; k < config.cross_section_heights.size(); ++k) {
+    ROS_INFO("mvog: ~cross_section_%zu is the cross-section at z = %.3f m", k,
+             config.cross_section_heights[k]);
+  }
 }
 
 GridPublication::~GridPublication() { stop(); }

@@ -29,6 +29,11 @@ MarkerPublication::MarkerPublication(ros::NodeHandle& private_nh, const Publicat
 
 MarkerPublication::~MarkerPublication() { stop(); }
 
+void MarkerPublication::reconfigure(double publish_period, double occupancy_threshold) {
+  ChangePublication::reconfigure(publish_period,
+                                 [&] { occupancy_threshold_ = occupancy_threshold; });
+}
+
 void MarkerPublication::clearPublished() {
   visualization_msgs::MarkerArray clear;
   clear.markers.push_back(deleteAllMarker(frame_id_, ros::Time::now()));

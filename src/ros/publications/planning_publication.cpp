@@ -35,6 +35,13 @@ PlanningPublication::PlanningPublication(ros::NodeHandle& private_nh,
 
 PlanningPublication::~PlanningPublication() { stop(); }
 
+void PlanningPublication::reconfigure(double publish_period, const mvog::PlanningConfig& planning) {
+  ChangePublication::reconfigure(publish_period, [&] {
+    frontiers_ = mvog::Frontiers(planning);
+    surfaces_ = mvog::Surfaces(planning);
+  });
+}
+
 void PlanningPublication::clearPublished() {
   frontiers_.clear();
   surfaces_.clear();

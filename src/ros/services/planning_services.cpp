@@ -32,6 +32,13 @@ PlanningServices::PlanningServices(ros::NodeHandle& private_nh, const QueryServi
       check_boxes_(
           private_nh.advertiseService("check_boxes", &PlanningServices::checkBoxes, this)) {}
 
+void PlanningServices::setPlanning(const mvog::PlanningConfig& planning) {
+  std::lock_guard<std::mutex> checker_lock(checker_mutex_);
+  planning_ = planning;
+  // What the checker found of open space followed the old threshold.
+  checker_ = mvog::SegmentChecker(planning);
+}
+
 std::optional<Eigen::Isometry3d> PlanningServices::acceptRequest(
     const std::string& frame_id, std::size_t count, std::size_t other_count, const char* what,
     const char* lists, std::string& refusal) const {
@@ -104,8 +111,13 @@ bool PlanningServices::checkBoxes(mvog::CheckBoxes::Request& request,
   }
   std::vector<mvog::BoxCheck> checks;
   try {
+    mvog::PlanningConfig planning;
+    {
+      std::lock_guard<std::mutex> checker_lock(checker_mutex_);
+      planning = planning_;
+    }
     std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
-    checks = mvog::checkBoxes(map_.map, boxes, planning_);
+    checks = mvog::checkBoxes(map_.map, boxes, planning);
   } catch (const mvog::ConfigError& e) {
     response.message = refusalOf(e);
     return true;

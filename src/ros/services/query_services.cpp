@@ -24,6 +24,10 @@ QueryServices::QueryServices(ros::NodeHandle& private_nh, const QueryServicesCon
       get_cross_section_(private_nh.advertiseService("get_cross_section",
                                                      &QueryServices::getCrossSection, this)) {}
 
+void QueryServices::setOccupancyThreshold(double occupancy_threshold) {
+  occupancy_threshold_ = occupancy_threshold;
+}
+
 bool QueryServices::getOccupancy(mvog::GetOccupancy::Request& request,
                                  mvog::GetOccupancy::Response& response) {
   if (!withinMaxQueryPoints(request.points.size(), "points", config_.max_query_points,
@@ -35,12 +39,13 @@ bool QueryServices::getOccupancy(mvog::GetOccupancy::Request& request,
   if (!map_from_frame) return true;
   response.probability.resize(request.points.size());
   response.state.resize(request.points.size());
+  const double occupancy_threshold = occupancy_threshold_;
   std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
   for (std::size_t k = 0; k < request.points.size(); ++k) {
     const mvog::PointOccupancy occupancy =
         map_.map.occupancy(*map_from_frame * toEigen(request.points[k]));
     response.probability[k] = occupancy.probability.value_or(std::nanf(""));
-    response.state[k] = static_cast<std::uint8_t>(occupancy.state(occupancy_threshold_));
+    response.state[k] = static_cast<std::uint8_t>(occupancy.state(occupancy_threshold));
   }
   response.success = true;
   return true;
