@@ -45,9 +45,9 @@ class InsertionWorker {
 
   /// Queues `scan` for insertion; `source` (its message type) names it in warnings.
   void enqueue(mvog::Scan&& scan, const std::string& source);
-  /// ~min_range and ~max_range changed (RuntimeReconfigure, validated already): the next scan
-  /// inserted uses them.
-  void setRanges(double min_range, double max_range);
+  /// ~min_range, ~max_range and ~evidence_limit changed (RuntimeReconfigure, validated
+  /// already): the next scan inserted uses them (`insertion`'s other fields are start-only).
+  void reconfigure(const mvog::InsertionConfig& insertion);
   /// Inserts what is queued, then ends the thread: nothing enqueued afterwards is inserted.
   void stop();
 
@@ -67,9 +67,10 @@ class InsertionWorker {
   /// and applied under its write lock; with ~backlog_insertion_threads if `backlog`.
   mvog::InsertionResult insert(const mvog::Scan& scan, bool backlog);
 
-  const InsertionWorkerConfig config_;  // its ranges: those at start (ranges_ follows)
-  mutable std::mutex ranges_mutex_;
-  std::pair<double, double> ranges_;  // min_range, max_range (under ranges_mutex_)
+  // Its ranges and evidence limit: those at start (reconfigured_ follows them).
+  const InsertionWorkerConfig config_;
+  mutable std::mutex reconfigured_mutex_;
+  mvog::InsertionConfig reconfigured_;  // under reconfigured_mutex_
   SharedMap& map_;
   mvog::ScanUpdate update_;  // its buffers and threads, kept from scan to scan
 

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <mutex>
 #include <shared_mutex>
-#include <tuple>
 #include <utility>
 
 #include <ros/console.h>
@@ -21,13 +20,13 @@ constexpr std::size_t kMinReadingsForBacklogThreads = 10000;
 
 InsertionWorker::InsertionWorker(const InsertionWorkerConfig& config, SharedMap& shared_map)
     : config_(config),
-      ranges_(config.min_range, config.max_range),
+      reconfigured_(config),
       map_(shared_map),
       thread_(&InsertionWorker::run, this) {}
 
-void InsertionWorker::setRanges(double min_range, double max_range) {
-  std::lock_guard<std::mutex> lock(ranges_mutex_);
-  ranges_ = {min_range, max_range};
+void InsertionWorker::reconfigure(const mvog::InsertionConfig& insertion) {
+  std::lock_guard<std::mutex> lock(reconfigured_mutex_);
+  reconfigured_ = insertion;
 }
 
 InsertionWorker::~InsertionWorker() { stop(); }
@@ -102,8 +101,10 @@ mvog::InsertionResult InsertionWorker::insert(const mvog::Scan& scan, bool backl
   // publications then wait for only while the scan's columns are merged.
   mvog::InsertionConfig insertion = config_;
   {
-    std::lock_guard<std::mutex> lock(ranges_mutex_);
-    std::tie(insertion.min_range, insertion.max_range) = ranges_;
+    std::lock_guard<std::mutex> lock(reconfigured_mutex_);
+    insertion.min_range = reconfigured_.min_range;
+    insertion.max_range = reconfigured_.max_range;
+    insertion.evidence_limit = reconfigured_.evidence_limit;
   }
   if (backlog) {
     insertion.insertion_threads =

@@ -90,7 +90,7 @@ void Mapper::reconfigure(const MapperConfig& config) {
   plan_path_.setPlanning(config.planning);
 #endif
   window_.reconfigure(config.lifetime.keep_radius, publish_period);
-  insertion_.setRanges(config.insertion.min_range, config.insertion.max_range);
+  insertion_.reconfigure(config.insertion);
   inputs_.setMaxRange(config.insertion.max_range, depthNoReturnLength(config.insertion.max_range));
   decay_.reconfigure(config.decay, config.lifetime.forget_mass);
 }

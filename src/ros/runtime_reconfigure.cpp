@@ -51,7 +51,8 @@ bool sameValues(const mvog::MapperReconfigureConfig& a, const mvog::MapperReconf
          a.decay_period == b.decay_period && a.forget_mass == b.forget_mass &&
          a.publish_period == b.publish_period &&
          a.cross_section_heights_text == b.cross_section_heights_text &&
-         a.keep_radius == b.keep_radius && a.min_range == b.min_range && a.max_range == b.max_range;
+         a.keep_radius == b.keep_radius && a.min_range == b.min_range &&
+         a.max_range == b.max_range && a.evidence_limit == b.evidence_limit;
 }
 
 }  // namespace
@@ -67,6 +68,7 @@ mvog::MapperReconfigureConfig reconfigurableValuesOf(const MapperConfig& config)
   values.keep_radius = config.lifetime.keep_radius;
   values.min_range = config.insertion.min_range;
   values.max_range = config.insertion.max_range;
+  values.evidence_limit = config.insertion.evidence_limit;
   return values;
 }
 
@@ -84,6 +86,7 @@ MapperConfig withReconfiguredValues(const MapperConfig& current,
   config.lifetime.keep_radius = values.keep_radius;
   config.insertion.min_range = values.min_range;
   config.insertion.max_range = values.max_range;
+  config.insertion.evidence_limit = values.evidence_limit;
   config.validate();
   return config;
 }
@@ -116,11 +119,11 @@ void RuntimeReconfigure::reconfigure(mvog::MapperReconfigureConfig& values, std:
   ROS_INFO(
       "mvog: dynamic_reconfigure: occupancy_threshold %g, decay_factor %g, decay_period %g "
       "s, forget_mass %g, publish_period %g s, cross_section_heights [%s], keep_radius %g m, "
-      "min_range %g m, max_range %g m",
+      "min_range %g m, max_range %g m, evidence_limit %g",
       config_.occupancy_threshold, config_.decay.decay_factor, config_.decay.decay_period,
       config_.lifetime.forget_mass, config_.publications.publish_period,
       heightsText(config_.publications.cross_section_heights).c_str(), config_.lifetime.keep_radius,
-      config_.insertion.min_range, config_.insertion.max_range);
+      config_.insertion.min_range, config_.insertion.max_range, config_.insertion.evidence_limit);
 }
 
 }  // namespace mvog_ros

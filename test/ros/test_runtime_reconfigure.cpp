@@ -38,6 +38,7 @@ TEST(RuntimeReconfigure, TheValuesInForceRoundTrip) {
   EXPECT_EQ(same.publications.cross_section_heights, start.publications.cross_section_heights);
   EXPECT_EQ(same.occupancy_threshold, start.occupancy_threshold);
   EXPECT_EQ(same.lifetime.keep_radius, start.lifetime.keep_radius);
+  EXPECT_EQ(same.insertion.evidence_limit, start.insertion.evidence_limit);
 }
 
 TEST(RuntimeReconfigure, NewValuesReachEveryPartsSlice) {
@@ -51,6 +52,7 @@ TEST(RuntimeReconfigure, NewValuesReachEveryPartsSlice) {
   values.keep_radius = 7.5;
   values.min_range = 0.3;
   values.max_range = 6.0;
+  values.evidence_limit = 30.0;
   const MapperConfig config = withReconfiguredValues(startConfig(), values);
   EXPECT_EQ(config.occupancy_threshold, 0.4);
   // The planners' threshold is the server's.
@@ -63,6 +65,7 @@ TEST(RuntimeReconfigure, NewValuesReachEveryPartsSlice) {
   EXPECT_EQ(config.lifetime.keep_radius, 7.5);
   EXPECT_EQ(config.insertion.min_range, 0.3);
   EXPECT_EQ(config.insertion.max_range, 6.0);
+  EXPECT_EQ(config.insertion.evidence_limit, 30.0);
 }
 
 TEST(RuntimeReconfigure, BadValuesAreRefusedNamingTheirParameter) {
@@ -80,6 +83,7 @@ TEST(RuntimeReconfigure, BadValuesAreRefusedNamingTheirParameter) {
       {"keep_radius", [](auto& v) { v.keep_radius = -1.0; }},
       {"min_range", [](auto& v) { v.min_range = -0.5; }},
       {"max_range", [](auto& v) { v.max_range = 0.0; }},
+      {"evidence_limit", [](auto& v) { v.evidence_limit = 0.5; }},
       {"min_range", [](auto& v) { v.min_range = 5.0, v.max_range = 4.0; }},
       {"cross_section_heights", [](auto& v) { v.cross_section_heights_text = "0.5, 1e9"; }},
       {"cross_section_heights_text", [](auto& v) { v.cross_section_heights_text = "0.5"; }},
