@@ -144,6 +144,12 @@ struct InsertionConfig {
 
   /// Throws ConfigError naming the first invalid field.
   void validate() const;
+  /// The evidence limit an insertion into a map of `rules` applies: evidence_limit with
+  /// MassCounting::kPerScan, none (infinity) with kPerReading.
+  double appliedEvidenceLimit(const ModelRules& rules) const {
+    return rules.mass_counting == MassCounting::kPerScan ? evidence_limit
+                                                         : std::numeric_limits<double>::infinity();
+  }
 };
 
 }  // namespace mvog

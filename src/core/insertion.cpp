@@ -328,19 +328,26 @@ bool mergeWithoutContact(const detail::ColumnRef& existing, const CellVolumes& a
          merger.keepsUnchanged(merged.negative, merged.positive, free_space_rules);
 }
 
+/// InsertionConfig::evidence_limit (`max_density`, in the tile's unit; infinite: none) on a
+/// column's lists as the update leaves them.
+void boundColumn(Volume* positive, std::size_t num_positive, Volume* negative,
+                 std::size_t num_negative, double max_density, std::vector<double>& work) {
+  if (!std::isinf(max_density)) {
+    boundEvidence(positive, num_positive, negative, num_negative, max_density, work);
+  }
+}
+
+/// boundColumn on a column changed in place.
+void boundStoredColumn(const detail::ColumnRef& column, double max_density,
+                       std::vector<double>& work) {
+  boundColumn(const_cast<Volume*>(column.positive), column.num_positive,
+              const_cast<Volume*>(column.negative), column.num_negative, max_density, work);
+}
+
 /// Merges what the scan saw in cell `local` of a tile (`hits`, and its scratches' free space)
 /// into the cell's lists `existing`, in place where their lengths stay, else into the tile's
 /// rewrite. Out of line: the loop over a tile's cells then keeps the commonest case's values in
 /// registers.
-/// InsertionConfig::evidence_limit (`max_density`, in the tile's unit; infinite: none) on a
-/// column changed in place.
-void boundStoredColumn(const detail::ColumnRef& column, double max_density,
-                       std::vector<double>& factors) {
-  if (std::isinf(max_density)) return;
-  boundEvidence(const_cast<Volume*>(column.positive), column.num_positive,
-                const_cast<Volume*>(column.negative), column.num_negative, max_density, factors);
-}
-
 [[gnu::noinline]] void updateColumn(unsigned local, HitRun hits, detail::ColumnRef existing,
                                     const ModelRules& rules, float unit_mass, double max_density,
                                     CellIndex origin, ColumnWork& work) {
@@ -376,10 +383,8 @@ void boundStoredColumn(const detail::ColumnRef& column, double max_density,
   }
   const auto num_positive = static_cast<std::uint32_t>(work.merged.positive.size());
   const auto num_negative = static_cast<std::uint32_t>(work.merged.negative.size());
-  if (!std::isinf(max_density)) {
-    boundEvidence(work.merged.positive.data(), num_positive, work.merged.negative.data(),
-                  num_negative, max_density, work.evidence_factors);
-  }
+  boundColumn(work.merged.positive.data(), num_positive, work.merged.negative.data(), num_negative,
+              max_density, work.evidence_factors);
   if (!existing.empty() && num_positive == existing.num_positive &&
       num_negative == existing.num_negative) {
     // Mostly every list keeps its length (new volumes merge into those there).
@@ -418,12 +423,11 @@ MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
           only_part->first->singleFree(*only_part->second, local, single)) {
         // The commonest cases without a vector in between: one free interval, no hit, changed
         // in the tile's own storage, or a cell's first volume.
-        Volume added{single.bottom, single.top,
-                     massOf(single, single.bottom, single.top, per_scan, unit_mass)};
+        const Volume added{single.bottom, single.top,
+                           massOf(single, single.bottom, single.top, per_scan, unit_mass)};
         if (existing.empty()) {
-          if (!std::isinf(max_density)) {
-            boundEvidence(nullptr, 0, &added, 1, max_density, work.evidence_factors);
-          }
+          // No evidence limit to apply: a cell's first volume holds one scan (density 1, the
+          // limit being at least 1; with per-reading masses there is no limit).
           // What the merge makes of one free volume and empty lists: that volume (a scan's free
           // interval is at least kMinVolumeHeight high, so no rule cuts it, and its mass, a sum
           // of heights times the unit, is never -0, which the merge's 0.0 + mass would make +0).

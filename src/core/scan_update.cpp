@@ -605,10 +605,7 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
   insertion.validate();
   Impl& impl = *impl_;
   impl.map_config = map_config;
-  // With per-reading masses (the paper's rules) densities count readings, not scans: unbounded.
-  impl.evidence_limit = map_config.rules.mass_counting == MassCounting::kPerScan
-                            ? insertion.evidence_limit
-                            : std::numeric_limits<double>::infinity();
+  impl.evidence_limit = insertion.appliedEvidenceLimit(map_config.rules);
   impl.result = InsertionResult{};
   const auto num_threads = static_cast<std::size_t>(insertion.insertion_threads);
   // A server switches between one thread and several as its queue backs up: the scratches of the

@@ -407,9 +407,9 @@ int main(int argc, char** argv) {
     report.rules = arguments.rules;
     report.octomap_clamping = arguments.octomap_clamping;
     report.occupancy_threshold = occupancyThreshold(arguments);
-    report.evidence_limit = arguments.rules.mass_counting == mvog::MassCounting::kPerScan
-                                ? arguments.evidence_limit
-                                : std::numeric_limits<double>::infinity();  // not applied
+    mvog::InsertionConfig insertion;
+    insertion.evidence_limit = arguments.evidence_limit;
+    report.evidence_limit = insertion.appliedEvidenceLimit(arguments.rules);
     report.out_of_range = arguments.out_of_range;
     report.repeat = arguments.repeat;
     const auto start = std::chrono::steady_clock::now();
