@@ -61,6 +61,18 @@ struct DepthImageConfig {
   void validate() const;
 };
 
+/// A depth image with the camera that took it and where: what inserting it straight from its
+/// pixels needs (Map::insertDepthImage, ScanUpdate::prepare). Views the image, does not own it.
+struct DepthFrame {
+  DepthImageView image;
+  PinholeCamera camera;
+  Eigen::Isometry3d map_from_camera = Eigen::Isometry3d::Identity();
+  DepthImageConfig config;
+
+  /// Throws ConfigError naming the first invalid field of the image, the camera or the config.
+  void validate() const;
+};
+
 /// The number of pixels `config` keeps of `image`.
 std::size_t keptPixels(const DepthImageView& image, const DepthImageConfig& config);
 
@@ -74,5 +86,7 @@ std::size_t keptPixels(const DepthImageView& image, const DepthImageConfig& conf
 Scan backProjectDepthImage(const DepthImageView& image, const PinholeCamera& camera,
                            const Eigen::Isometry3d& map_from_camera, const DepthImageConfig& config,
                            std::size_t& skipped_pixels);
+/// backProjectDepthImage of a DepthFrame.
+Scan backProjectDepthImage(const DepthFrame& frame, std::size_t& skipped_pixels);
 
 }  // namespace mvog

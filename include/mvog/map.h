@@ -45,6 +45,9 @@ struct InsertionResult {
   std::size_t rejected_out_of_bounds = 0;  ///< beyond MapConfig::max_coordinate
   std::size_t rejected_too_close = 0;      ///< hits nearer than min_range
   std::size_t ignored_out_of_range = 0;    ///< out-of-range readings with insert_out_of_range off
+  /// Pixels of a depth image without a measurement (0, NaN, negative, -Inf, or +Inf when
+  /// DepthImageConfig::no_return_length is infinite: REP-118), inserted straight from the image.
+  std::size_t rejected_no_measurement = 0;
   /// Rays walked for free space: one per inserted reading, or one per end voxel
   /// (FreeSpaceRays::kOnePerEndVoxel); not a count of readings.
   std::size_t rays_walked = 0;
@@ -57,7 +60,8 @@ struct InsertionResult {
 
   std::size_t inserted() const { return obstacle_readings + out_of_range_readings; }
   std::size_t rejected() const {
-    return rejected_non_finite + rejected_out_of_bounds + rejected_too_close + ignored_out_of_range;
+    return rejected_non_finite + rejected_out_of_bounds + rejected_too_close +
+           ignored_out_of_range + rejected_no_measurement;
   }
   InsertionResult& operator+=(const InsertionResult& other);
 };
@@ -145,6 +149,7 @@ struct GridTransform {
 };
 
 class ScanUpdate;
+struct DepthFrame;
 namespace detail {
 class TileBlock;
 struct MapUpdateCodec;
@@ -177,6 +182,10 @@ class Map {
   /// modified (apply). The map depends on the set of the scan's new volumes only: not on the
   /// order of its readings, nor on config.insertion_threads.
   InsertionResult insertScan(const Scan& scan, const InsertionConfig& config = {});
+  /// Inserts a depth image straight from its pixels: the map insertScan makes of the image's
+  /// readings (backProjectDepthImage), without a Scan of them in between when one ray per end
+  /// voxel is walked (ScanUpdate::prepare of a DepthFrame).
+  InsertionResult insertDepthImage(const DepthFrame& frame, const InsertionConfig& config = {});
   /// The scan of one reading ending at `end`: an obstacle reading, or an out-of-range reading.
   InsertionResult insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
                                 ReadingKind kind, const InsertionConfig& config = {});

@@ -460,6 +460,12 @@ InsertionResult Map::insertScan(const Scan& scan, const InsertionConfig& config)
   return apply(*own_update_);
 }
 
+InsertionResult Map::insertDepthImage(const DepthFrame& frame, const InsertionConfig& config) {
+  if (own_update_ == nullptr) own_update_ = std::make_unique<ScanUpdate>();
+  own_update_->prepare(frame, config_, config);
+  return apply(*own_update_);
+}
+
 InsertionResult Map::insertReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
                                    ReadingKind kind, const InsertionConfig& config) {
   Scan scan;

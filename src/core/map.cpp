@@ -32,6 +32,7 @@ InsertionResult& InsertionResult::operator+=(const InsertionResult& other) {
   rejected_non_finite += other.rejected_non_finite;
   rejected_out_of_bounds += other.rejected_out_of_bounds;
   rejected_too_close += other.rejected_too_close;
+  rejected_no_measurement += other.rejected_no_measurement;
   ignored_out_of_range += other.ignored_out_of_range;
   rays_walked += other.rays_walked;
   obstacle_seconds += other.obstacle_seconds;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "mvog/constraints.h"
+#include "mvog/depth_image.h"
 #include "mvog/scan_update.h"
 #include "thread_pool.h"
 #include "tile_block.h"
@@ -169,8 +170,8 @@ class alignas(kCacheLine) ScanScratch {
     }
 
     /// Called for every cell a ray crosses: the commonest case (the interval inline grows)
-    /// stays inline in the ray walk.
-    void addFree(const Volume& volume) {
+    /// stays inline in the ray walk (forced: see walkReading in scan_update.cpp).
+    [[gnu::always_inline]] void addFree(const Volume& volume) {
       ScratchTile& tile = *tile_;
       const unsigned local = currentLocal();
       if constexpr (kLevel) {  // every free volume of the scan is the level one
@@ -405,24 +406,20 @@ class alignas(kCacheLine) EndVoxelRays {
     }
     offerElsewhere(voxel, end, hit);
   }
-  /// Calls add(cell, volume) with the union of the hits' volumes of each obstacle's voxel.
-  template <class Add>
-  void forEachHit(Add&& add) const {
-    for (const VoxelReadings& voxel : voxels_) {
-      if (voxel.obstacle) add(voxel.cell, volumeOfMinimumHeight(voxel.hits_bottom, voxel.hits_top));
-    }
+  /// The voxels offered, in the order first offered.
+  const std::vector<VoxelReadings>& voxels() const { return voxels_; }
+  /// The union of the hits' volumes of an obstacle's voxel.
+  static Volume hitsOf(const VoxelReadings& voxel) {
+    return volumeOfMinimumHeight(voxel.hits_bottom, voxel.hits_top);
   }
-  /// Calls walk(end, obstacle) for the ray of each reading to walk, voxel after voxel in the
-  /// order they were first offered.
+  /// Calls walk(end) for the ray of each of the voxel's readings to walk.
   template <class Walk>
-  void forEachRay(Walk&& walk) const {
-    for (const VoxelReadings& voxel : voxels_) {
-      if (voxel.count >= kReadingsForOneRay) {
-        walk(voxel.nearest, voxel.obstacle);
-        continue;
-      }
-      for (std::uint32_t k = 0; k < voxel.count; ++k) walk(voxel.ends[k], voxel.obstacle);
+  static void forEachRayOf(const VoxelReadings& voxel, Walk&& walk) {
+    if (voxel.count >= kReadingsForOneRay) {
+      walk(voxel.nearest);
+      return;
     }
+    for (std::uint32_t k = 0; k < voxel.count; ++k) walk(voxel.ends[k]);
   }
 
  private:
@@ -477,11 +474,59 @@ void joinSorted(std::vector<ScanInterval>& intervals, float join_gap);
 /// Which thread's scratch each reading of a scan goes to, and what decided it: kept from scan
 /// to scan.
 struct ReadingSplit {
-  std::vector<std::uint8_t> chunk_of_reading;    ///< by reading: hits, then out-of-range ones
+  /// By reading (hits, then out-of-range ones), or by end voxel (splitEndVoxelsBySector).
+  std::vector<std::uint8_t> chunk_of_reading;
   std::vector<std::uint16_t> sector_of_reading;  ///< the direction of its ray
   std::vector<double> cells_in_sector;           ///< the cell visits of the sector's readings
   std::vector<double> cells_in_part;  ///< the same by run of readings (a thread's), then sector
 };
+/// How far from the sensor a reading of `kind` may free space (m): a hit up to max_range, a
+/// reading without a return up to out_of_range_free_length too (ModelRules).
+inline double freeLengthOf(ReadingKind kind, const MapConfig& map_config,
+                           const InsertionConfig& config) {
+  return kind == ReadingKind::kObstacle
+             ? config.max_range
+             : std::min(config.max_range, map_config.rules.out_of_range_free_length);
+}
+
+/// Where a reading's ray from `origin` to `end`, `length` long, stops freeing space: its end, or
+/// `free_length` along it.
+inline Eigen::Vector3d freeEnd(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
+                               double length, double free_length) {
+  return length > free_length ? Eigen::Vector3d(origin + (end - origin) * (free_length / length))
+                              : end;
+}
+
+/// Eq. (5): a hit's positive volume, one cell high around its height `end_z` (grid units).
+inline Volume hitVolume(float end_z) { return makeVolume(end_z - 0.5f, end_z + 0.5f); }
+
+/// Checks one reading and counts it in `result`; on acceptance sets the ray's end (truncated to
+/// max_range) and whether it ends in an obstacle. `origin_accepted`: the scan's origin is within
+/// the map's bounds (checked once a scan).
+bool acceptReading(const Eigen::Vector3d& origin, bool origin_accepted, const Eigen::Vector3d& end,
+                   ReadingKind kind, const MapConfig& map_config, const InsertionConfig& config,
+                   Eigen::Vector3d& ray_end, bool& obstacle, InsertionResult& result);
+
+/// What grouping a scan's readings by end voxel learnt of them all (groupByEndVoxel).
+struct GroupedScan {
+  /// The cells of the origin and of every accepted reading's end: every walk stays within them.
+  CellRange cells = kNoCells;
+  /// Every accepted reading at the origin's height: a level scan (addReading's level ray).
+  bool level = true;
+};
+
+/// Checks and counts (in `result`) every reading of `scan`, and offers the accepted ones to
+/// `voxels` (begun), in one pass over them (FreeSpaceRays::kOnePerEndVoxel). Nothing is walked
+/// yet: the walks follow the voxels.
+GroupedScan groupByEndVoxel(const Scan& scan, const MapConfig& map_config,
+                            const InsertionConfig& insertion, EndVoxelRays& voxels,
+                            InsertionResult& result);
+/// The same straight from the pixels of a depth image (validated), the pixels without a
+/// measurement counted in result.rejected_no_measurement.
+GroupedScan groupByEndVoxel(const DepthFrame& frame, const MapConfig& map_config,
+                            const InsertionConfig& insertion, EndVoxelRays& voxels,
+                            InsertionResult& result);
+
 /// Whether a scan's free space is walked one ray per end voxel (FreeSpaceRays).
 inline bool walksOneRayPerEndVoxel(const MapConfig& map_config, const InsertionConfig& insertion) {
   return map_config.rules.mass_counting == MassCounting::kPerScan &&
@@ -493,6 +538,10 @@ inline bool walksOneRayPerEndVoxel(const MapConfig& map_config, const InsertionC
 void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
                            const InsertionConfig& insertion, std::size_t chunks, ThreadPool* pool,
                            ReadingSplit& split);
+/// Splits a scan's end voxels (FreeSpaceRays::kOnePerEndVoxel) among `chunks` threads, the rays
+/// from `start` (grid units).
+void splitEndVoxelsBySector(const EndVoxelRays& voxels, const Eigen::Vector3d& start,
+                            std::size_t chunks, ReadingSplit& split);
 /// The gap under which one scan's intervals join (see ScanInterval).
 inline float joinGapOf(const ModelRules& rules) {
   return rules.mass_counting == MassCounting::kPerScan ? kMaxMergeGap : 0.0f;
@@ -521,6 +570,7 @@ struct alignas(kCacheLine) ColumnWork {
 
 struct ScanUpdate::Impl {
   MapConfig map_config;
+  InsertionConfig insertion;  ///< of the scan prepared
   /// InsertionConfig::evidence_limit of the scan prepared (Map::apply bounds the columns with it).
   double evidence_limit = std::numeric_limits<double>::infinity();
   InsertionResult result;
@@ -528,9 +578,9 @@ struct ScanUpdate::Impl {
   std::vector<detail::ScanScratch> scratches;
   /// Those of threads the last scan did not use, kept with their memory.
   std::vector<detail::ScanScratch> idle_scratches;
-  /// One per chunk too (at least): its end voxels and their rays
-  /// (FreeSpaceRays::kOnePerEndVoxel).
-  std::vector<detail::EndVoxelRays> end_voxels;
+  /// The scan's end voxels and their rays (FreeSpaceRays::kOnePerEndVoxel), grouped before the
+  /// chunks walk them.
+  detail::EndVoxelRays end_voxels;
   /// With several threads: the scratch of each reading of the scan (splitReadingsBySector).
   detail::ReadingSplit split;
   std::unique_ptr<detail::ThreadPool> pool;

@@ -12,6 +12,7 @@
 #include <optional>
 #include <utility>
 
+#include "mvog/depth_image.h"
 #include "mvog/raster.h"
 #include "scan_scratch.h"
 
@@ -29,69 +30,6 @@ void joinSorted(std::vector<ScanInterval>& intervals, float join_gap) {
     }
   }
   intervals.resize(out);
-}
-
-void EndVoxelRays::begin() {
-  voxels_.clear();
-  if (++stamp_ == std::uint32_t{1} << 31) {  // the tag holds 31 bits of stamp: start again
-    for (Slot& slot : slots_) slot.tag = 0;
-    stamp_ = 1;
-  }
-}
-
-namespace {
-
-std::size_t hashOf(std::int32_t x, std::int32_t y, std::int32_t z) {
-  std::uint64_t h = static_cast<std::uint32_t>(x) * 0x9E3779B97F4A7C15ull;
-  h ^= static_cast<std::uint32_t>(y) * 0xC2B2AE3D27D4EB4Full;
-  h ^= static_cast<std::uint32_t>(z) * 0x165667B19E3779F9ull;
-  return static_cast<std::size_t>(h ^ (h >> 32));
-}
-
-}  // namespace
-
-void EndVoxelRays::place(const Slot& slot) {
-  const std::size_t mask = slots_.size() - 1;
-  std::size_t k = hashOf(slot.x, slot.y, slot.z) & mask;
-  while (slots_[k].tag >> 1 == stamp_) k = (k + 1) & mask;
-  slots_[k] = slot;
-}
-
-void EndVoxelRays::grow() {
-  std::vector<Slot> old(std::max<std::size_t>(1024, 2 * slots_.size()), Slot{0, 0, 0, 0, 0});
-  old.swap(slots_);
-  for (const Slot& slot : old) {
-    if (slot.tag >> 1 == stamp_) place(slot);
-  }
-}
-
-void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end,
-                                  const Volume* hit) {
-  last_ = voxel;
-  const std::uint32_t tag = stamp_ << 1 | static_cast<std::uint32_t>(voxel.obstacle);
-  if (2 * (voxels_.size() + 1) > slots_.size()) grow();
-  const std::size_t mask = slots_.size() - 1;
-  std::size_t k = hashOf(voxel.x, voxel.y, voxel.z) & mask;
-  for (;; k = (k + 1) & mask) {
-    const Slot& slot = slots_[k];
-    if (slot.tag >> 1 != stamp_) break;
-    if (slot.tag == tag && slot.x == voxel.x && slot.y == voxel.y && slot.z == voxel.z) {
-      last_index_ = slot.index;
-      join(voxels_[last_index_], voxel, end, hit);
-      return;
-    }
-  }
-  // A scan holds fewer than 2^32 readings.
-  last_index_ = static_cast<std::uint32_t>(voxels_.size());
-  slots_[k] = {voxel.x, voxel.y, voxel.z, tag, last_index_};
-  voxels_.push_back({{end},
-                     end,
-                     centreDistance(voxel, end),
-                     {voxel.x, voxel.y},
-                     hit != nullptr ? hit->bottom : 0.0f,
-                     hit != nullptr ? hit->top : 0.0f,
-                     1,
-                     voxel.obstacle});
 }
 
 /// The most tiles a scan's dense tile index spans (512 KB of pointers); a scan reaching wider
@@ -282,59 +220,6 @@ void ScanScratch::appendFree(const ScratchTile& tile, unsigned local,
 
 namespace {
 
-/// How far from the sensor a reading of `kind` may free space (m): a hit up to max_range, a
-/// reading without a return up to out_of_range_free_length too (ModelRules).
-double freeLengthOf(ReadingKind kind, const MapConfig& map_config, const InsertionConfig& config) {
-  return kind == ReadingKind::kObstacle
-             ? config.max_range
-             : std::min(config.max_range, map_config.rules.out_of_range_free_length);
-}
-
-/// Where a reading's ray from `origin` to `end`, `length` long, stops freeing space: its end, or
-/// `free_length` along it.
-Eigen::Vector3d freeEnd(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, double length,
-                        double free_length) {
-  return length > free_length ? Eigen::Vector3d(origin + (end - origin) * (free_length / length))
-                              : end;
-}
-
-/// Checks one reading and counts it in `result`; on acceptance sets the ray's end (truncated to
-/// max_range) and whether it ends in an obstacle.
-bool acceptReading(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, ReadingKind kind,
-                   const MapConfig& map_config, const InsertionConfig& config,
-                   Eigen::Vector3d& ray_end, bool& obstacle, InsertionResult& result) {
-  const bool is_obstacle = kind == ReadingKind::kObstacle;
-  if (!map_config.withinBounds(origin) || !map_config.withinBounds(end)) {
-    if (!origin.allFinite() || !end.allFinite()) {
-      ++result.rejected_non_finite;
-    } else {
-      ++result.rejected_out_of_bounds;
-    }
-    return false;
-  }
-  const Eigen::Vector3d ray = end - origin;
-  const double length = ray.norm();
-  // A zero-length out-of-range reading carries no free space; a zero-length hit is below any
-  // min_range but the sensor itself (decision: both are dropped as too close).
-  if (length == 0.0 || (is_obstacle && length < config.min_range)) {
-    ++result.rejected_too_close;
-    return false;
-  }
-  obstacle = is_obstacle && length <= config.max_range;
-  if (!obstacle && !config.insert_out_of_range) {
-    ++result.ignored_out_of_range;
-    return false;
-  }
-  ray_end = freeEnd(origin, end, length, freeLengthOf(kind, map_config, config));
-  if (obstacle) {
-    ++result.obstacle_readings;
-  } else {
-    ++result.out_of_range_readings;
-    if (is_obstacle) ++result.truncated_to_max_range;
-  }
-  return true;
-}
-
 /// The heights (grid units) below which a float is within 1/32 of the double it rounds: two
 /// heights half a cell apart stay less than a cell apart as floats.
 constexpr double kShallowRayMaxHeight = 1 << 20;
@@ -343,29 +228,32 @@ constexpr double kShallowRayMaxHeight = 1 << 20;
 /// height, so every cell it crosses gets this one free volume.
 Volume levelRayVolume(float height) { return makeVolume(height, height); }
 
-/// Eq. (5): a hit's positive volume, one cell high around its height `end_z` (grid units).
-Volume hitVolume(float end_z) { return makeVolume(end_z - 0.5f, end_z + 0.5f); }
-
 /// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`,
 /// each cell's free volume from `free_volume(z_enter, z_exit)`; an obstacle's own positive
 /// volume only if `add_hit` (FreeSpaceRays::kOnePerEndVoxel adds each hit's apart).
+/// Forced inline, with its visit and ScanScratch::Writer::addFree: GCC's inliner left them out of
+/// the walk's loop once this file held the walks of both insertions (every reading's, each end
+/// voxel's), the writer then lived in memory instead of registers, and the TUM bag's insertion
+/// took 25 % longer.
 template <class Writer, class FreeVolume>
-void walkReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool obstacle,
-                 bool add_hit, Writer& scratch, const FreeVolume& free_volume) {
+[[gnu::always_inline]] inline void walkReading(const Eigen::Vector3d& start,
+                                               const Eigen::Vector3d& end, bool obstacle,
+                                               bool add_hit, Writer& scratch,
+                                               const FreeVolume& free_volume) {
   const auto end_z = static_cast<float>(end.z());
-  walkRayWith(scratch, start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
-              [&](double z_enter, double z_exit, bool is_last) {
-                if (!is_last || !obstacle) {  // eqs. (3) and (4)
-                  scratch.addFree(free_volume(z_enter, z_exit));
-                  return;
-                }
-                const Volume positive = hitVolume(end_z);
-                if (add_hit) scratch.addHit(positive);
-                if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
-                  scratch.addFree(makeVolume(static_cast<float>(z_enter),
-                                             z_enter < end.z() ? positive.bottom : positive.top));
-                }
-              });
+  auto visit = [&](double z_enter, double z_exit, bool is_last) __attribute__((always_inline)) {
+    if (!is_last || !obstacle) {  // eqs. (3) and (4)
+      scratch.addFree(free_volume(z_enter, z_exit));
+      return;
+    }
+    const Volume positive = hitVolume(end_z);
+    if (add_hit) scratch.addHit(positive);
+    if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
+      scratch.addFree(makeVolume(static_cast<float>(z_enter),
+                                 z_enter < end.z() ? positive.bottom : positive.top));
+    }
+  };
+  walkRayWith(scratch, start.x(), start.y(), start.z(), end.x(), end.y(), end.z(), visit);
 }
 
 /// A hit's positive volume alone (eq. 5), in the cell a walk to `end` (grid units) would end in
@@ -406,62 +294,77 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
 }
 
 /// The readings of `scan` (its hits, then its out-of-range readings) that `mine(k)` gives to
-/// this chunk, checked, counted and rasterised into `writer`.
+/// this chunk, checked, counted and rasterised into `writer`, every reading's ray walked.
 template <class Writer, class Mine>
 void rasterizeReadings(const Scan& scan, const Mine& mine, const MapConfig& map_config,
-                       const InsertionConfig& insertion, EndVoxelRays* end_voxels, Writer& writer,
-                       InsertionResult& result) {
+                       const InsertionConfig& insertion, Writer& writer, InsertionResult& result) {
   const double s = 1.0 / map_config.resolution;
   const Eigen::Vector3d start = scan.origin * s;
+  const bool origin_accepted = map_config.withinBounds(scan.origin);
   const std::size_t num_hits = scan.hits.size();
   auto add = [&](const Eigen::Vector3f& end, ReadingKind kind) {
     Eigen::Vector3d ray_end;
     bool obstacle = false;
-    if (!acceptReading(scan.origin, end.cast<double>(), kind, map_config, insertion, ray_end,
-                       obstacle, result)) {
+    if (!acceptReading(scan.origin, origin_accepted, end.cast<double>(), kind, map_config,
+                       insertion, ray_end, obstacle, result)) {
       return;
     }
     const Eigen::Vector3d end_cells = ray_end * s;
     if (!insertion.model_negative_space) {  // only the obstacle's own volume: no walk
       if (obstacle) addHitAt(end_cells, writer);
-    } else if (end_voxels == nullptr) {
-      addReading(start, end_cells, obstacle, true, writer);
-      ++result.rays_walked;
-    } else if (obstacle) {  // the voxel's hits and its rays once all its readings are offered
-      const Volume hit = hitVolume(static_cast<float>(end_cells.z()));
-      end_voxels->offer(end_cells, &hit);
-    } else {
-      end_voxels->offer(end_cells, nullptr);
+      return;
     }
-  };
-  // The rays of the end voxels whose readings ended in an obstacle, or not.
-  auto walk_voxel_rays = [&](bool obstacle) {
-    if (end_voxels == nullptr) return;
-    end_voxels->forEachRay([&](const Eigen::Vector3d& end, bool ends_in_obstacle) {
-      if (ends_in_obstacle != obstacle) return;
-      addReading(start, end, obstacle, false, writer);
-      ++result.rays_walked;
-    });
+    addReading(start, end_cells, obstacle, true, writer);
+    ++result.rays_walked;
   };
   const auto began = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < num_hits; ++k) {
     if (mine(k)) add(scan.hits[k], ReadingKind::kObstacle);
   }
-  if (end_voxels != nullptr) {  // every voxel of an obstacle reading is complete
-    end_voxels->forEachHit([&](const CellIndex& cell, const Volume& hits) {
-      auto hit_writer = writer;
-      hit_writer.moveTo(cell);
-      hit_writer.addHit(hits);
-    });
-  }
-  walk_voxel_rays(true);
   const auto hits_done = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < scan.out_of_range.size(); ++k) {
     if (mine(num_hits + k)) add(scan.out_of_range[k], ReadingKind::kOutOfRange);
   }
-  walk_voxel_rays(false);
   result.obstacle_seconds = std::chrono::duration<double>(hits_done - began).count();
   result.out_of_range_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - hits_done).count();
+}
+
+/// The tiles of `cells`.
+CellRange tilesOf(const CellRange& cells) {
+  if (cells.empty()) return kNoCells;
+  return {{cells.min.x >> kTileSizeLog2, cells.min.y >> kTileSizeLog2},
+          {cells.max.x >> kTileSizeLog2, cells.max.y >> kTileSizeLog2}};
+}
+
+/// The hits and rays of the end voxels of `voxels` that `mine(k)` gives to this chunk (voxel k),
+/// rasterised into `writer`: the hits, then the rays of the voxels of obstacle readings, then
+/// the others'.
+template <class Writer, class Mine>
+void rasterizeEndVoxels(const EndVoxelRays& voxels, const Mine& mine, const Eigen::Vector3d& start,
+                        Writer& writer, InsertionResult& result) {
+  const std::vector<VoxelReadings>& all = voxels.voxels();
+  const auto began = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    if (!all[k].obstacle || !mine(k)) continue;
+    auto hit_writer = writer;
+    hit_writer.moveTo(all[k].cell);
+    hit_writer.addHit(EndVoxelRays::hitsOf(all[k]));
+  }
+  auto walk = [&](bool obstacle) {
+    for (std::size_t k = 0; k < all.size(); ++k) {
+      if (all[k].obstacle != obstacle || !mine(k)) continue;
+      EndVoxelRays::forEachRayOf(all[k], [&](const Eigen::Vector3d& end) {
+        addReading(start, end, obstacle, false, writer);
+        ++result.rays_walked;
+      });
+    }
+  };
+  walk(true);
+  const auto hits_done = std::chrono::steady_clock::now();
+  walk(false);
+  result.obstacle_seconds += std::chrono::duration<double>(hits_done - began).count();
+  result.out_of_range_seconds +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - hits_done).count();
 }
 
@@ -473,6 +376,36 @@ constexpr std::size_t kSectors = 1024;
 float pseudoAngle(double dx, double dy) {
   const double p = dx / (std::fabs(dx) + std::fabs(dy));
   return static_cast<float>(dy >= 0.0 ? 1.0 - p : 3.0 + p);
+}
+
+/// The sector of a ray's direction (dx, dy) in xy; a vertical ray has none: sector 0.
+std::uint16_t sectorOf(const Eigen::Vector2d& direction) {
+  if (direction.x() == 0.0 && direction.y() == 0.0) return 0;
+  return static_cast<std::uint16_t>(
+      std::min<double>(kSectors - 1, pseudoAngle(direction.x(), direction.y()) * (kSectors / 4.0)));
+}
+
+/// Gives each sector to one of `chunks` threads: around the circle from the sector with the
+/// fewest cells (outside a camera's field of view, or a 360-degree sensor's emptiest direction),
+/// each chunk takes consecutive sectors until it holds its share of `cells_in` (cell visits by
+/// sector).
+void chunksOfSectors(const std::vector<double>& cells_in, std::size_t chunks,
+                     std::uint8_t (&chunk_of_sector)[kSectors]) {
+  const std::size_t first = static_cast<std::size_t>(
+      std::min_element(cells_in.begin(), cells_in.end()) - cells_in.begin());
+  double total = 0.0;
+  for (double cells : cells_in) total += cells;
+  double so_far = 0.0;
+  std::size_t chunk = 0;
+  for (std::size_t n = 0; n < kSectors; ++n) {
+    const std::size_t sector = (first + n) % kSectors;
+    while (chunk + 1 < chunks &&
+           so_far >= total * static_cast<double>(chunk + 1) / static_cast<double>(chunks)) {
+      ++chunk;
+    }
+    chunk_of_sector[sector] = static_cast<std::uint8_t>(chunk);
+    so_far += cells_in[sector];
+  }
 }
 
 }  // namespace
@@ -496,10 +429,8 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
   const std::size_t parts = pool != nullptr ? pool->threads() : 1;
   split.cells_in_part.assign(parts * kSectors, 0.0);
   const bool origin_accepted = map_config.withinBounds(scan.origin);
-  const bool by_end_voxel = walksOneRayPerEndVoxel(map_config, insertion);
   auto sectors_of_part = [&](std::size_t, std::size_t part) {
     double* cells_in = split.cells_in_part.data() + part * kSectors;
-    std::optional<EndVoxel> previous_voxel;  // of the reading before, by_end_voxel
     for (std::size_t k = num_readings * part / parts; k < num_readings * (part + 1) / parts; ++k) {
       const bool is_hit = k < num_hits;
       const Eigen::Vector3d end =
@@ -516,28 +447,9 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
       const double free_length = freeLengthOf(
           is_hit ? ReadingKind::kObstacle : ReadingKind::kOutOfRange, map_config, insertion);
       // The walk takes |di| + |dj| steps over the part of the ray it frees: the cells it costs.
-      double walk_cells =
+      sector_of[k] = sectorOf(ray.head<2>());
+      cells_in[sector_of[k]] +=
           (std::fabs(ray.x()) + std::fabs(ray.y())) * std::min(1.0, free_length / length) * s + 1.0;
-      Eigen::Vector2d direction = ray.head<2>();
-      if (by_end_voxel) {
-        // The readings of an end voxel go to the one chunk that walks its ray (EndVoxelRays): by
-        // the direction of the voxel's centre. A reading ending in the voxel of the one before (a
-        // depth image's neighbouring pixel, mostly) adds no walk of its own, only about a cell's
-        // cost of grouping: so the chunks share the walks, not the readings.
-        const EndVoxel voxel =
-            endVoxelOf(freeEnd(scan.origin, end, length, free_length) * s, false);
-        direction = Eigen::Vector2d(voxel.x + 0.5, voxel.y + 0.5) - scan.origin.head<2>() * s;
-        if (previous_voxel && *previous_voxel == voxel) walk_cells = 1.0;
-        previous_voxel = voxel;
-      }
-      // A vertical ray has no direction in xy: it crosses one column, in sector 0.
-      const bool vertical = direction.x() == 0.0 && direction.y() == 0.0;
-      const auto sector = static_cast<std::uint16_t>(
-          vertical ? 0.0
-                   : std::min<double>(kSectors - 1, pseudoAngle(direction.x(), direction.y()) *
-                                                        (kSectors / 4.0)));
-      sector_of[k] = sector;
-      cells_in[sector] += walk_cells;
     }
   };
   if (pool != nullptr) {
@@ -552,27 +464,38 @@ void splitReadingsBySector(const Scan& scan, const MapConfig& map_config,
       cells_in[sector] += split.cells_in_part[part * kSectors + sector];
     }
   }
-  // Around the circle from the sector with the fewest cells (outside a camera's field of view,
-  // or a 360-degree sensor's emptiest direction), each chunk takes consecutive sectors until it
-  // holds its share of the cells.
-  const std::size_t first = static_cast<std::size_t>(
-      std::min_element(cells_in.begin(), cells_in.end()) - cells_in.begin());
-  double total = 0.0;
-  for (double cells : cells_in) total += cells;
   std::uint8_t chunk_of_sector[kSectors];
-  double so_far = 0.0;
-  std::size_t chunk = 0;
-  for (std::size_t n = 0; n < kSectors; ++n) {
-    const std::size_t sector = (first + n) % kSectors;
-    while (chunk + 1 < chunks &&
-           so_far >= total * static_cast<double>(chunk + 1) / static_cast<double>(chunks)) {
-      ++chunk;
-    }
-    chunk_of_sector[sector] = static_cast<std::uint8_t>(chunk);
-    so_far += cells_in[sector];
-  }
+  chunksOfSectors(cells_in, chunks, chunk_of_sector);
   split.chunk_of_reading.resize(num_readings);
   for (std::size_t k = 0; k < num_readings; ++k) {
+    split.chunk_of_reading[k] = chunk_of_sector[sector_of[k]];
+  }
+}
+
+/// Gives each end voxel of `voxels` to one of `chunks` threads (split.chunk_of_reading[k] for
+/// voxel k) as splitReadingsBySector gives readings: by the direction of the voxel's centre from
+/// `start` (the origin, grid units), weighed by the cells its rays walk. A voxel's readings are
+/// grouped before the split, so the rays walked do not depend on the number of threads.
+void splitEndVoxelsBySector(const EndVoxelRays& voxels, const Eigen::Vector3d& start,
+                            std::size_t chunks, ReadingSplit& split) {
+  const std::vector<VoxelReadings>& all = voxels.voxels();
+  std::vector<std::uint16_t>& sector_of = split.sector_of_reading;
+  sector_of.resize(all.size());
+  std::vector<double>& cells_in = split.cells_in_sector;
+  cells_in.assign(kSectors, 0.0);
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const VoxelReadings& voxel = all[k];
+    sector_of[k] =
+        sectorOf(Eigen::Vector2d(voxel.cell.x + 0.5, voxel.cell.y + 0.5) - start.head<2>());
+    EndVoxelRays::forEachRayOf(voxel, [&](const Eigen::Vector3d& end) {
+      cells_in[sector_of[k]] +=
+          std::fabs(end.x() - start.x()) + std::fabs(end.y() - start.y()) + 1.0;
+    });
+  }
+  std::uint8_t chunk_of_sector[kSectors];
+  chunksOfSectors(cells_in, chunks, chunk_of_sector);
+  split.chunk_of_reading.resize(all.size());
+  for (std::size_t k = 0; k < all.size(); ++k) {
     split.chunk_of_reading[k] = chunk_of_sector[sector_of[k]];
   }
 }
@@ -599,12 +522,12 @@ bool ScanUpdate::preparedFor(const MapConfig& map_config) const {
          prepared.max_coordinate == map_config.max_coordinate && prepared.rules == map_config.rules;
 }
 
-void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
-                         const InsertionConfig& insertion) {
+void ScanUpdate::begin(const MapConfig& map_config, const InsertionConfig& insertion) {
   map_config.validate();
   insertion.validate();
   Impl& impl = *impl_;
   impl.map_config = map_config;
+  impl.insertion = insertion;
   impl.evidence_limit = insertion.appliedEvidenceLimit(map_config.rules);
   impl.result = InsertionResult{};
   const auto num_threads = static_cast<std::size_t>(insertion.insertion_threads);
@@ -619,11 +542,92 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
     impl.idle_scratches.pop_back();
   }
   impl.scratches.resize(num_threads);
-  const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
-  const bool one_ray_per_end_voxel = detail::walksOneRayPerEndVoxel(map_config, insertion);
-  if (one_ray_per_end_voxel && impl.end_voxels.size() < num_threads) {
-    impl.end_voxels.resize(num_threads);
+}
+
+void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
+                         const InsertionConfig& insertion) {
+  begin(map_config, insertion);
+  if (!detail::walksOneRayPerEndVoxel(map_config, insertion)) {
+    prepareEveryReading(scan);
+    return;
   }
+  Impl& impl = *impl_;
+  const auto began = std::chrono::steady_clock::now();
+  impl.end_voxels.begin();
+  const detail::GroupedScan grouped =
+      detail::groupByEndVoxel(scan, map_config, insertion, impl.end_voxels, impl.result);
+  walkEndVoxels(scan.origin, grouped.cells, grouped.level, began);
+}
+
+void ScanUpdate::prepare(const DepthFrame& frame, const MapConfig& map_config,
+                         const InsertionConfig& insertion) {
+  map_config.validate();
+  insertion.validate();
+  frame.validate();
+  if (!detail::walksOneRayPerEndVoxel(map_config, insertion)) {
+    // Every reading's ray walked (FreeSpaceRays::kEveryReading, or masses counted per reading):
+    // the readings are split among threads before they are walked, from a Scan of them.
+    std::size_t skipped = 0;
+    const Scan scan = backProjectDepthImage(frame, skipped);
+    prepare(scan, map_config, insertion);
+    impl_->result.rejected_no_measurement = skipped;
+    return;
+  }
+  begin(map_config, insertion);
+  Impl& impl = *impl_;
+  const auto began = std::chrono::steady_clock::now();
+  impl.end_voxels.begin();
+  const detail::GroupedScan grouped =
+      detail::groupByEndVoxel(frame, map_config, insertion, impl.end_voxels, impl.result);
+  walkEndVoxels(frame.map_from_camera.translation(), grouped.cells, grouped.level, began);
+}
+
+void ScanUpdate::walkEndVoxels(const Eigen::Vector3d& origin, const CellRange& cells, bool level,
+                               std::chrono::steady_clock::time_point grouping_began) {
+  Impl& impl = *impl_;
+  const MapConfig& map_config = impl.map_config;
+  // Grouping is timed with the obstacle readings (a depth image's pixels are read once for both
+  // kinds).
+  impl.result.obstacle_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - grouping_began).count();
+  const std::size_t num_threads = impl.scratches.size();
+  const Eigen::Vector3d start = origin * (1.0 / map_config.resolution);
+  if (num_threads > 1) {
+    detail::splitEndVoxelsBySector(impl.end_voxels, start, num_threads, impl.split);
+  }
+  const CellRange tiles = detail::tilesOf(cells);
+  const Volume level_volume = detail::levelRayVolume(static_cast<float>(start.z()));
+  const float join_gap = detail::joinGapOf(map_config.rules);
+  std::vector<InsertionResult> results(num_threads);
+  // The end voxels of chunk k (split.chunk_of_reading) go to scratch k.
+  auto rasterize = [&](std::size_t, std::size_t chunk) {
+    detail::ScanScratch& scratch = impl.scratches[chunk];
+    auto mine = [&](std::size_t k) {
+      return num_threads == 1 || impl.split.chunk_of_reading[k] == chunk;
+    };
+    scratch.begin(join_gap, false, tiles, level ? &level_volume : nullptr);
+    if (level) {
+      detail::ScanScratch::Writer<false, true> writer(scratch);
+      detail::rasterizeEndVoxels(impl.end_voxels, mine, start, writer, results[chunk]);
+    } else {
+      detail::ScanScratch::Writer<false> writer(scratch);
+      detail::rasterizeEndVoxels(impl.end_voxels, mine, start, writer, results[chunk]);
+    }
+  };
+  if (detail::ThreadPool* pool = impl.threads(num_threads)) {
+    pool->run(num_threads, rasterize);
+  } else {
+    rasterize(0, 0);
+  }
+  for (const InsertionResult& r : results) impl.result += r;
+}
+
+void ScanUpdate::prepareEveryReading(const Scan& scan) {
+  Impl& impl = *impl_;
+  const MapConfig& map_config = impl.map_config;
+  const InsertionConfig& insertion = impl.insertion;
+  const std::size_t num_threads = impl.scratches.size();
+  const bool count_masses = map_config.rules.mass_counting == MassCounting::kPerReading;
   const std::size_t num_hits = scan.hits.size();
   const std::size_t num_readings = num_hits + scan.out_of_range.size();
   const double s = 1.0 / map_config.resolution;
@@ -661,32 +665,21 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
     }
     CellRange tiles = kNoCells;
     if (low.x() <= high.x()) {
-      auto tile_of = [&](const Eigen::Vector2d& p) {
-        const CellIndex cell = cellAt(p.x() * s, p.y() * s);
-        return CellIndex{cell.x >> detail::kTileSizeLog2, cell.y >> detail::kTileSizeLog2};
-      };
-      tiles = {tile_of(low), tile_of(high)};
-    }
-    detail::EndVoxelRays* end_voxels = nullptr;
-    if (one_ray_per_end_voxel) {
-      end_voxels = &impl.end_voxels[chunk];
-      end_voxels->begin();
+      tiles =
+          detail::tilesOf({cellAt(low.x() * s, low.y() * s), cellAt(high.x() * s, high.y() * s)});
     }
     const Volume level_volume = detail::levelRayVolume(static_cast<float>(scan.origin.z() * s));
     scratch.begin(detail::joinGapOf(map_config.rules), count_masses, tiles,
                   level ? &level_volume : nullptr);
     if (count_masses) {
       detail::ScanScratch::Writer<true> writer(scratch);
-      detail::rasterizeReadings(scan, mine, map_config, insertion, end_voxels, writer,
-                                results[chunk]);
+      detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
     } else if (level) {
       detail::ScanScratch::Writer<false, true> writer(scratch);
-      detail::rasterizeReadings(scan, mine, map_config, insertion, end_voxels, writer,
-                                results[chunk]);
+      detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
     } else {
       detail::ScanScratch::Writer<false> writer(scratch);
-      detail::rasterizeReadings(scan, mine, map_config, insertion, end_voxels, writer,
-                                results[chunk]);
+      detail::rasterizeReadings(scan, mine, map_config, insertion, writer, results[chunk]);
     }
   };
   if (detail::ThreadPool* pool = impl.threads(num_threads)) {

@@ -8,9 +8,11 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mvog/depth_image.h"
+#include "mvog/map.h"
 #include "test_util.h"
 
 namespace mvog {
@@ -142,6 +144,8 @@ TEST(BackProjectDepthImage, TakesAnEmptyImage) {
   EXPECT_TRUE(backProject(view, skipped).hits.empty());
 }
 
+/// Both the back-projection and the insertion straight from the image refuse the image, naming
+/// `field`, and the map stays as it was.
 void expectRefused(const DepthImageView& view, const PinholeCamera& camera,
                    const DepthImageConfig& config, const std::string& field) {
   std::size_t skipped = 0;
@@ -151,6 +155,18 @@ void expectRefused(const DepthImageView& view, const PinholeCamera& camera,
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()).rfind(field + ":", 0), 0u) << e.what();
   }
+  Map map(MapConfig{});
+  map.insertReading({0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, ReadingKind::kObstacle);
+  const std::vector<test::VolumeRecord> before = test::allVolumes(map);
+  const std::uint64_t revision = map.revision();
+  try {
+    map.insertDepthImage({view, camera, Eigen::Isometry3d::Identity(), config});
+    ADD_FAILURE() << "inserted; expected a refusal naming " << field;
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(field + ":", 0), 0u) << e.what();
+  }
+  EXPECT_TRUE(test::sameVolumes(test::allVolumes(map), before));
+  EXPECT_EQ(map.revision(), revision);
 }
 
 TEST(BackProjectDepthImage, RefusesImagesCamerasAndConfigsItCannotUseNamingTheField) {
@@ -188,6 +204,168 @@ TEST(BackProjectDepthImage, RefusesImagesCamerasAndConfigsItCannotUseNamingTheFi
   expectRefused(valid.view, kCamera, config, "no_return_length");
   config.no_return_length = nan;
   expectRefused(valid.view, kCamera, config, "no_return_length");
+}
+
+// ---- Straight from the image (Map::insertDepthImage) ------------------------------------------
+
+/// A Kinect's intrinsics at 640 x 480.
+const PinholeCamera kKinect{525.0, 525.0, 319.5, 239.5};
+constexpr std::uint32_t kKinectWidth = 640;
+constexpr std::uint32_t kKinectHeight = 480;
+
+/// The camera 1.2 m above the floor looking along +x, pitched 10 degrees down and turned 30
+/// degrees: optical z forward, x right, y down.
+Eigen::Isometry3d cameraPose() {
+  Eigen::Matrix3d looking_along_x;
+  looking_along_x << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translate(Eigen::Vector3d(0.3, -0.2, 1.2));
+  pose.rotate(Eigen::AngleAxisd(0.5236, Eigen::Vector3d::UnitZ()) *
+              Eigen::AngleAxisd(0.1745, Eigen::Vector3d::UnitY()) * looking_along_x);
+  return pose;
+}
+
+/// The depth (along the optical axis) of pixel (u, v) seeing a wall `wall` m ahead with a
+/// vertical pole of radius `pole_radius` m in front of it, `pole_depth` m ahead and 0.3 m to
+/// the right (the pole along the image's columns); no pole if pole_radius is 0.
+double sceneDepth(std::uint32_t u, std::uint32_t v, double wall, double pole_depth = 0.0,
+                  double pole_radius = 0.0) {
+  const double a = (u - kKinect.cx) / kKinect.fx;  // x / z along the pixel's ray
+  static_cast<void>(v);
+  double depth = wall;
+  if (pole_radius > 0.0) {
+    // (a t - 0.3)^2 + (t - pole_depth)^2 = r^2, t the depth.
+    const double qa = a * a + 1.0;
+    const double qb = -2.0 * (0.3 * a + pole_depth);
+    const double qc = 0.09 + pole_depth * pole_depth - pole_radius * pole_radius;
+    const double discriminant = qb * qb - 4.0 * qa * qc;
+    if (discriminant >= 0.0) depth = std::min(depth, (-qb - std::sqrt(discriminant)) / (2.0 * qa));
+  }
+  return depth;
+}
+
+/// A Kinect-sized image of sceneDepth, in either encoding, with every 97th pixel set to
+/// `special` (NaN, 0, +Inf, -Inf, or a saturated 65535 mm), so that every kind of pixel comes.
+template <class Pixel>
+Image<Pixel> sceneImage(double wall, double pole_depth, double pole_radius, Pixel special) {
+  std::vector<Pixel> pixels;
+  for (std::uint32_t v = 0; v < kKinectHeight; ++v) {
+    for (std::uint32_t u = 0; u < kKinectWidth; ++u) {
+      const double depth = sceneDepth(u, v, wall, pole_depth, pole_radius);
+      Pixel pixel = sizeof(Pixel) == 2 ? static_cast<Pixel>(std::lround(1000.0 * depth))
+                                       : static_cast<Pixel>(depth);
+      if ((v * kKinectWidth + u) % 97 == 0) pixel = special;
+      pixels.push_back(pixel);
+    }
+  }
+  return Image<Pixel>(kKinectWidth, pixels, 4);
+}
+
+/// Inserting `frame` straight from its pixels makes the map, and counts, of inserting the Scan
+/// backProjectDepthImage makes of it, bit for bit.
+void expectSameAsItsScan(const DepthFrame& frame, const MapConfig& map_config,
+                         const InsertionConfig& insertion) {
+  std::size_t skipped = 0;
+  const Scan scan = backProjectDepthImage(frame, skipped);
+  Map from_scan(map_config);
+  Map from_image(map_config);
+  const InsertionResult scan_result = from_scan.insertScan(scan, insertion);
+  const InsertionResult image_result = from_image.insertDepthImage(frame, insertion);
+  EXPECT_TRUE(test::sameVolumes(test::allVolumes(from_image), test::allVolumes(from_scan)));
+  EXPECT_EQ(image_result.obstacle_readings, scan_result.obstacle_readings);
+  EXPECT_EQ(image_result.out_of_range_readings, scan_result.out_of_range_readings);
+  EXPECT_EQ(image_result.truncated_to_max_range, scan_result.truncated_to_max_range);
+  EXPECT_EQ(image_result.rays_walked, scan_result.rays_walked);
+  EXPECT_EQ(image_result.rejected_too_close, scan_result.rejected_too_close);
+  EXPECT_EQ(image_result.rejected_no_measurement, skipped);
+  EXPECT_EQ(image_result.rejected(), scan_result.rejected() + skipped);
+  EXPECT_EQ(image_result.inserted() + image_result.rejected(),
+            keptPixels(frame.image, frame.config));
+}
+
+TEST(InsertDepthImage, MakesTheMapOfTheImagesReadingsBitForBitWhateverTheThreadsAndOptions) {
+  const auto mm = sceneImage<std::uint16_t>(3.5, 2.0, 0.05, 0);
+  const auto metres = sceneImage<float>(3.5, 2.0, 0.05, std::numeric_limits<float>::quiet_NaN());
+  const auto no_return = sceneImage<float>(3.5, 2.0, 0.05, kFloatInf);
+  const auto too_close = sceneImage<float>(3.5, 2.0, 0.05, -kFloatInf);
+  const auto saturated = sceneImage<std::uint16_t>(3.5, 2.0, 0.05, 65535);
+  DepthImageConfig strided;
+  strided.stride = 3;
+  DepthImageConfig free_when_no_return;
+  free_when_no_return.no_return_length = 3.0;
+  InsertionConfig ranged;
+  ranged.min_range = 0.8;
+  ranged.max_range = 3.0;
+  InsertionConfig every_reading;
+  every_reading.free_space_rays = FreeSpaceRays::kEveryReading;
+  MapConfig paper;
+  paper.resolution = 0.05;
+  paper.rules = ModelRules::paper();
+  MapConfig defaults;
+  defaults.resolution = 0.05;
+  const struct {
+    const char* name;
+    DepthImageView image;
+    DepthImageConfig config;
+    MapConfig map;
+    InsertionConfig insertion;
+  } cases[] = {
+      {"16UC1, zeros", mm.view, {}, defaults, {}},
+      {"32FC1, NaNs, stride 3", metres.view, strided, defaults, {}},
+      {"+Inf freeing 3 m", no_return.view, free_when_no_return, defaults, {}},
+      {"+Inf skipped", no_return.view, {}, defaults, {}},
+      {"-Inf", too_close.view, {}, defaults, {}},
+      {"saturated 65535 mm, min and max range", saturated.view, {}, defaults, ranged},
+      {"every reading's ray", no_return.view, free_when_no_return, defaults, every_reading},
+      {"the paper's model", mm.view, {}, paper, {}},
+  };
+  for (const auto& c : cases) {
+    for (int threads : {1, 2, 4}) {
+      SCOPED_TRACE(std::string(c.name) + ", " + std::to_string(threads) + " threads");
+      InsertionConfig insertion = c.insertion;
+      insertion.insertion_threads = threads;
+      expectSameAsItsScan({c.image, kKinect, cameraPose(), c.config}, c.map, insertion);
+    }
+  }
+}
+
+TEST(InsertDepthImage, AWallAt1And4MetresAndA2cmPoleAt3MetresAreOccupiedAcrossTheImage) {
+  // Every pixel inserted: every hit's point is occupied, the pole's too (3.5 pixels wide: a
+  // stride of 4 could miss it), and the space halfway to the hits is free.
+  for (const auto& [wall, pole_radius] : {std::pair{1.0, 0.0}, std::pair{4.0, 0.01}}) {
+    SCOPED_TRACE("wall at " + std::to_string(wall) + " m");
+    const auto image = sceneImage<float>(wall, 3.0, pole_radius, static_cast<float>(wall));
+    const DepthFrame frame{image.view, kKinect, cameraPose(), {}};
+    MapConfig config;
+    config.resolution = 0.05;
+    Map map(config);
+    const InsertionResult result = map.insertDepthImage(frame);
+    EXPECT_EQ(result.obstacle_readings, std::size_t{kKinectWidth} * kKinectHeight);
+    EXPECT_LT(result.rays_walked, result.obstacle_readings / 5);
+    std::size_t skipped = 0;
+    const Scan scan = backProjectDepthImage(frame, skipped);
+    std::size_t occupied = 0;
+    std::size_t free_halfway = 0;
+    std::size_t pole = 0;
+    std::size_t pole_occupied = 0;
+    for (std::size_t k = 0; k < scan.hits.size(); ++k) {
+      const Eigen::Vector3d hit = scan.hits[k].cast<double>();
+      const bool is_occupied = test::stateAt(map, hit) == OccupancyState::kOccupied;
+      occupied += is_occupied;
+      free_halfway += test::stateAt(map, 0.5 * (scan.origin + hit)) == OccupancyState::kFree;
+      const std::uint32_t u = static_cast<std::uint32_t>(k % kKinectWidth);
+      if (pole_radius > 0.0 && sceneDepth(u, 0, wall, 3.0, pole_radius) < wall) {
+        ++pole;
+        pole_occupied += is_occupied;
+      }
+    }
+    EXPECT_EQ(occupied, scan.hits.size());
+    EXPECT_GE(100 * free_halfway, 99 * scan.hits.size());
+    if (pole_radius > 0.0) {
+      EXPECT_GE(pole, 3u * kKinectHeight);
+      EXPECT_EQ(pole_occupied, pole);
+    }
+  }
 }
 
 }  // namespace
