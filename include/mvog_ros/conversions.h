@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <variant>
 
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -40,18 +41,39 @@ mvog::Scan laserScanToScan(const sensor_msgs::LaserScan& scan,
 mvog::Scan pointCloudToScan(const sensor_msgs::PointCloud2& cloud,
                             const Eigen::Isometry3d& map_from_sensor, std::size_t max_points);
 
-/// A depth image with its camera info as an mvog::Scan (mvog::backProjectDepthImage with the
-/// camera info's K: the image rectified, as depth drivers publish it), from the optical frame's
-/// origin. REP-118: encoding "16UC1" (millimetres) or "32FC1" (metres); 0, NaN and -Inf say
-/// nothing (counted in `skipped_pixels`), +Inf is an out-of-range reading.
+/// A depth image with its camera info as an mvog::DepthFrame viewing `image`'s data (the camera
+/// info's K: the image rectified, as depth drivers publish it), the camera at `map_from_camera`.
+/// REP-118: encoding "16UC1" (millimetres) or "32FC1" (metres).
 /// Throws InvalidMessage for another encoding, big-endian data, a step or data too short for the
 /// image, a camera info of another size than the image or whose K is zero or non-finite, or more
 /// than max_points pixels kept.
+mvog::DepthFrame depthFrameOf(const sensor_msgs::Image& image,
+                              const sensor_msgs::CameraInfo& camera_info,
+                              const Eigen::Isometry3d& map_from_camera,
+                              const mvog::DepthImageConfig& config, std::size_t max_points);
+
+/// depthFrameOf's frame as an mvog::Scan (mvog::backProjectDepthImage), from the optical frame's
+/// origin: 0, NaN and -Inf say nothing (counted in `skipped_pixels`), +Inf is an out-of-range
+/// reading. Throws InvalidMessage as depthFrameOf.
 mvog::Scan depthImageToScan(const sensor_msgs::Image& image,
                             const sensor_msgs::CameraInfo& camera_info,
                             const Eigen::Isometry3d& map_from_camera,
                             const mvog::DepthImageConfig& config, std::size_t max_points,
                             std::size_t& skipped_pixels);
+
+/// A depth image inserted straight from its pixels (mvog::Map::insertDepthImage): the frame views
+/// the image message, kept alive with it.
+struct DepthImageReadings {
+  sensor_msgs::ImageConstPtr image;
+  mvog::DepthFrame frame;
+};
+
+/// What a sensor message becomes for the insertion: a Scan, or a depth image.
+using SensorReadings = std::variant<mvog::Scan, DepthImageReadings>;
+
+/// The readings `readings` holds (a depth image's kept pixels), and where they were taken from.
+std::size_t readingCount(const SensorReadings& readings);
+Eigen::Vector3d sensorOrigin(const SensorReadings& readings);
 
 /// Keeps one point per voxel of edge `leaf_size` (the centroid of its points), with PCL.
 /// Non-finite points are dropped: returns how many.

@@ -12,6 +12,7 @@
 
 #include "mvog/map.h"
 #include "mvog/scan_update.h"
+#include "mvog_ros/conversions.h"
 #include "mvog_ros/mapper_config.h"
 #include "mvog_ros/shared_map.h"
 
@@ -43,8 +44,8 @@ class InsertionWorker {
   InsertionWorker(const InsertionWorker&) = delete;
   InsertionWorker& operator=(const InsertionWorker&) = delete;
 
-  /// Queues `scan` for insertion; `source` (its message type) names it in warnings.
-  void enqueue(mvog::Scan&& scan, const std::string& source);
+  /// Queues `readings` for insertion; `source` (its message type) names them in warnings.
+  void enqueue(SensorReadings&& readings, const std::string& source);
   /// ~min_range, ~max_range and ~evidence_limit changed (RuntimeReconfigure, validated
   /// already): the next scan inserted uses them (`insertion`'s other fields are start-only).
   void reconfigure(const mvog::InsertionConfig& insertion);
@@ -57,15 +58,15 @@ class InsertionWorker {
   std::optional<Eigen::Vector3d> latestOrigin() const;
 
  private:
-  struct QueuedScan {
-    mvog::Scan scan;
+  struct QueuedReadings {
+    SensorReadings readings;
     std::string source;
   };
 
   void run();
-  /// The worker's one call into the core: `scan` into the map, prepared outside the map's lock
-  /// and applied under its write lock; with ~backlog_insertion_threads if `backlog`.
-  mvog::InsertionResult insert(const mvog::Scan& scan, bool backlog);
+  /// The worker's one call into the core: `readings` into the map, prepared outside the map's
+  /// lock and applied under its write lock; with ~backlog_insertion_threads if `backlog`.
+  mvog::InsertionResult insert(const SensorReadings& readings, bool backlog);
 
   // Its ranges and evidence limit: those at start (reconfigured_ follows them).
   const InsertionWorkerConfig config_;
@@ -76,7 +77,7 @@ class InsertionWorker {
 
   std::mutex queue_mutex_;
   std::condition_variable queue_changed_;
-  std::deque<QueuedScan> queue_;
+  std::deque<QueuedReadings> queue_;
   bool stopping_ = false;
 
   std::atomic<std::uint64_t> messages_inserted_{0};

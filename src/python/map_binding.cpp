@@ -93,11 +93,10 @@ std::pair<mvog::InsertionResult, std::size_t> insertDepthImage(
   view.step = view.width * mvog::DepthImageView::bytesPerPixel(view.encoding);
   const Eigen::Isometry3d map_from_camera = isometryOf(pose, "pose");
   py::gil_scoped_release no_gil;
-  std::size_t skipped = 0;
-  const mvog::Scan scan =
-      mvog::backProjectDepthImage(view, camera, map_from_camera, depth_config, skipped);
   auto [map, lock] = handle.write();
-  return {map.insertScan(scan, config), skipped};
+  const mvog::InsertionResult result =
+      map.insertDepthImage({view, camera, map_from_camera, depth_config}, config);
+  return {result, result.rejected_no_measurement};
 }
 
 /// Merges `other` into `handle`'s map, both locked (in one order, whoever merges which).
@@ -134,6 +133,8 @@ void bindMap(py::module_& module) {
       .def_readonly("rejected_out_of_bounds", &mvog::InsertionResult::rejected_out_of_bounds)
       .def_readonly("rejected_too_close", &mvog::InsertionResult::rejected_too_close)
       .def_readonly("ignored_out_of_range", &mvog::InsertionResult::ignored_out_of_range)
+      .def_readonly("rejected_no_measurement", &mvog::InsertionResult::rejected_no_measurement,
+                    "depth pixels without a measurement (0, NaN, negative, -Inf)")
       .def_readonly("rays_walked", &mvog::InsertionResult::rays_walked)
       .def_readonly("obstacle_seconds", &mvog::InsertionResult::obstacle_seconds,
                     "thread time rasterising the obstacle readings (s)")

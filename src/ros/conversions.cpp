@@ -124,11 +124,10 @@ mvog::Scan pointCloudToScan(const sensor_msgs::PointCloud2& cloud,
   return readings;
 }
 
-mvog::Scan depthImageToScan(const sensor_msgs::Image& image,
-                            const sensor_msgs::CameraInfo& camera_info,
-                            const Eigen::Isometry3d& map_from_camera,
-                            const mvog::DepthImageConfig& config, std::size_t max_points,
-                            std::size_t& skipped_pixels) {
+mvog::DepthFrame depthFrameOf(const sensor_msgs::Image& image,
+                              const sensor_msgs::CameraInfo& camera_info,
+                              const Eigen::Isometry3d& map_from_camera,
+                              const mvog::DepthImageConfig& config, std::size_t max_points) {
   mvog::DepthImageView view;
   if (image.encoding == "16UC1") {
     view.encoding = mvog::DepthEncoding::kUint16Millimetres;
@@ -168,7 +167,31 @@ mvog::Scan depthImageToScan(const sensor_msgs::Image& image,
     throw InvalidMessage("depth image keeps " + std::to_string(pixels) +
                          " pixels, more than ~max_points_per_message");
   }
-  return mvog::backProjectDepthImage(view, camera, map_from_camera, config, skipped_pixels);
+  return {view, camera, map_from_camera, config};
+}
+
+mvog::Scan depthImageToScan(const sensor_msgs::Image& image,
+                            const sensor_msgs::CameraInfo& camera_info,
+                            const Eigen::Isometry3d& map_from_camera,
+                            const mvog::DepthImageConfig& config, std::size_t max_points,
+                            std::size_t& skipped_pixels) {
+  return mvog::backProjectDepthImage(
+      depthFrameOf(image, camera_info, map_from_camera, config, max_points), skipped_pixels);
+}
+
+std::size_t readingCount(const SensorReadings& readings) {
+  if (const auto* depth = std::get_if<DepthImageReadings>(&readings)) {
+    return mvog::keptPixels(depth->frame.image, depth->frame.config);
+  }
+  const mvog::Scan& scan = std::get<mvog::Scan>(readings);
+  return scan.hits.size() + scan.out_of_range.size();
+}
+
+Eigen::Vector3d sensorOrigin(const SensorReadings& readings) {
+  if (const auto* depth = std::get_if<DepthImageReadings>(&readings)) {
+    return depth->frame.map_from_camera.translation();
+  }
+  return std::get<mvog::Scan>(readings).origin;
 }
 
 std::size_t voxelFilter(std::vector<Eigen::Vector3f>& points, double leaf_size) {

@@ -31,7 +31,7 @@ void InsertionWorker::reconfigure(const mvog::InsertionConfig& insertion) {
 
 InsertionWorker::~InsertionWorker() { stop(); }
 
-void InsertionWorker::enqueue(mvog::Scan&& scan, const std::string& source) {
+void InsertionWorker::enqueue(SensorReadings&& readings, const std::string& source) {
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);
     if (queue_.size() >= static_cast<std::size_t>(config_.insertion_queue_size)) {
@@ -42,7 +42,7 @@ void InsertionWorker::enqueue(mvog::Scan&& scan, const std::string& source) {
                         "message (%llu so far)",
                         static_cast<unsigned long long>(messages_dropped_queue_.load()));
     }
-    queue_.push_back({std::move(scan), source});
+    queue_.push_back({std::move(readings), source});
   }
   queue_changed_.notify_one();
 }
@@ -58,7 +58,7 @@ void InsertionWorker::stop() {
 
 void InsertionWorker::run() {
   for (;;) {
-    QueuedScan queued;
+    QueuedReadings queued;
     bool backlog = false;  // another message waits behind this one, and it is large
     {
       std::unique_lock<std::mutex> lock(queue_mutex_);
@@ -66,11 +66,10 @@ void InsertionWorker::run() {
       if (queue_.empty()) return;  // stopping, and what was queued is in the map
       queued = std::move(queue_.front());
       queue_.pop_front();
-      backlog = !queue_.empty() && queued.scan.hits.size() + queued.scan.out_of_range.size() >=
-                                       kMinReadingsForBacklogThreads;
+      backlog = !queue_.empty() && readingCount(queued.readings) >= kMinReadingsForBacklogThreads;
     }
     const auto start = std::chrono::steady_clock::now();
-    const mvog::InsertionResult result = insert(queued.scan, backlog);
+    const mvog::InsertionResult result = insert(queued.readings, backlog);
     insertion_nanoseconds_ +=
         static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                        std::chrono::steady_clock::now() - start)
@@ -85,7 +84,7 @@ void InsertionWorker::run() {
     if (backlog) ++backlog_insertions_;
     {
       std::lock_guard<std::mutex> lock(origin_mutex_);
-      latest_origin_ = queued.scan.origin;
+      latest_origin_ = sensorOrigin(queued.readings);
     }
     if (result.rejected_out_of_bounds > 0) {
       ROS_WARN_THROTTLE(kWarningPeriod,
@@ -95,7 +94,7 @@ void InsertionWorker::run() {
   }
 }
 
-mvog::InsertionResult InsertionWorker::insert(const mvog::Scan& scan, bool backlog) {
+mvog::InsertionResult InsertionWorker::insert(const SensorReadings& readings, bool backlog) {
   // The scan goes in whole (Fig. 2: the constraints once per scan). Its rasterisation reads
   // nothing of the map but its configuration: it runs outside the lock, which queries and
   // publications then wait for only while the scan's columns are merged.
@@ -115,11 +114,18 @@ mvog::InsertionResult InsertionWorker::insert(const mvog::Scan& scan, bool backl
     std::shared_lock<WriterPreferringMutex> lock(map_.mutex);
     map_config = map_.map.config();
   }
-  update_.prepare(scan, map_config, insertion);
+  auto prepare = [&](const mvog::MapConfig& config) {
+    if (const auto* depth = std::get_if<DepthImageReadings>(&readings)) {
+      update_.prepare(depth->frame, config, insertion);
+    } else {
+      update_.prepare(std::get<mvog::Scan>(readings), config, insertion);
+    }
+  };
+  prepare(map_config);
   std::unique_lock<WriterPreferringMutex> lock(map_.mutex);
   if (!update_.preparedFor(map_.map.config())) {
     // ~load_map put a map of another configuration in place meanwhile.
-    update_.prepare(scan, map_.map.config(), insertion);
+    prepare(map_.map.config());
   }
   return map_.map.apply(update_);
 }

@@ -36,8 +36,8 @@ Mapper::Mapper(const ros::NodeHandle& nh, ros::NodeHandle private_nh)
       decay_(private_nh, config_.decay, config_.lifetime.forget_mass, map_),
       inputs_(nh, config_.inputs, config_.frame_id, config_.insertion.max_range,
               depthNoReturnLength(config_.insertion.max_range), tf_buffer_,
-              [this](mvog::Scan&& scan, const std::string& source) {
-                insertion_.enqueue(std::move(scan), source);
+              [this](SensorReadings&& readings, const std::string& source) {
+                insertion_.enqueue(std::move(readings), source);
               }),
       reset_(
           private_nh, map_, [this](mvog::Map&& map) { replaceMap(std::move(map)); },

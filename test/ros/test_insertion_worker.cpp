@@ -1,15 +1,19 @@
 // InsertionWorker (mvog_ros/insertion_worker.h): every queued scan goes into the map or is
 // counted as dropped (the oldest first when the queue is full), pieces of large scans build the
-// map of the whole scan, and stop() inserts what is queued.
+// map of the whole scan, depth images go in straight from their pixels, and stop() inserts what
+// is queued.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <thread>
 #include <vector>
 
 #include <ros/time.h>
 
+#include "mvog/depth_image.h"
 #include "mvog/map_io.h"
 #include "mvog_ros/insertion_worker.h"
 
@@ -147,6 +151,70 @@ TEST_F(InsertionWorkerTest, ABacklogInsertedOnMoreThreadsBuildsTheSameMap) {
   EXPECT_GE(worker.statistics().backlog_insertions, scans.size() - 2);
   EXPECT_LE(worker.statistics().backlog_insertions, scans.size() - 1);
   EXPECT_EQ(mvog::serializeMap(shared_map.map), mvog::serializeMap(one_by_one));
+}
+
+/// A 160 x 120 depth image (32FC1) of a wall 3 m ahead, the camera at (0, 0, 1) looking along +x,
+/// every 7th pixel without a measurement (NaN), as the server queues it (DepthImageReadings).
+DepthImageReadings depthImageOfAWall(float wall, std::uint32_t seed) {
+  constexpr std::uint32_t kWidth = 160;
+  constexpr std::uint32_t kHeight = 120;
+  auto image = boost::make_shared<sensor_msgs::Image>();
+  image->width = kWidth;
+  image->height = kHeight;
+  image->encoding = "32FC1";
+  image->step = kWidth * sizeof(float);
+  image->data.resize(std::size_t{image->step} * kHeight);
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> noise(-0.01f, 0.01f);
+  for (std::size_t k = 0; k < std::size_t{kWidth} * kHeight; ++k) {
+    const float depth = k % 7 == 0 ? NAN : wall + noise(random);
+    std::memcpy(image->data.data() + k * sizeof(float), &depth, sizeof depth);
+  }
+  sensor_msgs::CameraInfo info;
+  info.width = kWidth;
+  info.height = kHeight;
+  info.K = {130.0, 0.0, 79.5, 0.0, 130.0, 59.5, 0.0, 0.0, 1.0};
+  Eigen::Matrix3d looking_along_x;
+  looking_along_x << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translate(Eigen::Vector3d(0.0, 0.0, 1.0));
+  pose.rotate(looking_along_x);
+  return {image, depthFrameOf(*image, info, pose, mvog::DepthImageConfig{}, 1000000)};
+}
+
+TEST_F(InsertionWorkerTest, DepthImagesGoInStraightFromTheirPixelsAsTheirScansWould) {
+  // Queued as images (no Scan of their pixels), on one thread or on the backlog's four: the map
+  // of inserting each image's Scan one by one, the pixels without a measurement counted.
+  std::vector<DepthImageReadings> images;
+  for (std::uint32_t k = 0; k < 6; ++k) images.push_back(depthImageOfAWall(3.0f + 0.1f * k, k));
+  mvog::Map one_by_one(mapConfig());
+  std::size_t skipped_total = 0;
+  for (const DepthImageReadings& image : images) {
+    std::size_t skipped = 0;
+    one_by_one.insertScan(mvog::backProjectDepthImage(image.frame, skipped));
+    skipped_total += skipped;
+  }
+  ASSERT_GT(skipped_total, 0u);
+  for (int backlog_threads : {1, 4}) {
+    SharedMap shared_map{mvog::Map(mapConfig())};
+    InsertionWorkerConfig config;
+    config.insertion_queue_size = 100;
+    config.backlog_insertion_threads = backlog_threads;
+    InsertionWorker worker(config, shared_map);
+    {
+      std::unique_lock<WriterPreferringMutex> lock(shared_map.mutex);
+      for (const DepthImageReadings& image : images)
+        worker.enqueue(DepthImageReadings(image), "test");
+    }
+    worker.stop();
+    EXPECT_EQ(worker.statistics().messages_inserted, images.size());
+    EXPECT_EQ(worker.statistics().readings_rejected, skipped_total);
+    EXPECT_EQ(mvog::serializeMap(shared_map.map), mvog::serializeMap(one_by_one))
+        << backlog_threads << " backlog threads";
+    const std::optional<Eigen::Vector3d> origin = worker.latestOrigin();
+    ASSERT_TRUE(origin.has_value());
+    EXPECT_EQ(*origin, Eigen::Vector3d(0.0, 0.0, 1.0));
+  }
 }
 
 TEST_F(InsertionWorkerTest, ScansGoIntoMapsReplacedWhileTheyArePrepared) {

@@ -32,7 +32,7 @@ class DepthImageInput : public SensorInput {
 
   /// Converts `image` with its camera info and the camera's pose and enqueues it; an invalid
   /// pair is dropped, counted.
-  void convertAndEnqueue(const sensor_msgs::Image& image,
+  void convertAndEnqueue(const sensor_msgs::ImageConstPtr& image,
                          const sensor_msgs::CameraInfo& camera_info,
                          const Eigen::Isometry3d& map_from_camera);
 

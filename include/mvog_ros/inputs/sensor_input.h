@@ -39,7 +39,7 @@ struct InputCounters {
 };
 
 /// Where a converted message goes (InsertionWorker::enqueue); `source` is its message type.
-using EnqueueScan = std::function<void(mvog::Scan&& scan, const std::string& source)>;
+using EnqueueReadings = std::function<void(SensorReadings&& readings, const std::string& source)>;
 
 /// What every sensor input is given: its parameters, the map frame, the tf buffer to wait on,
 /// the counters of what it drops, and where converted messages go.
@@ -48,7 +48,7 @@ struct SensorInputContext {
   std::string frame_id;
   const tf2_ros::Buffer& tf_buffer;
   InputCounters& counters;
-  EnqueueScan enqueue;
+  EnqueueReadings enqueue;
 };
 
 /// One sensor topic: its subscription, and its messages waiting for the transform into the map
@@ -82,15 +82,17 @@ class SensorInput {
           });
         });
   }
-  /// Enqueues the scan `convert(skipped)` returns, the readings it skipped counted as rejected;
+  /// Enqueues the readings `convert(skipped)` returns (a Scan, or a depth image inserted straight
+  /// from its pixels, whose pixels without a measurement the insertion counts), the readings it
+  /// skipped counted as rejected;
   /// a message it throws InvalidMessage for is dropped, counted, with a throttled warning.
   template <class Convert>
   void enqueueConverted(const std::string& message_type, Convert&& convert) {
     try {
       std::size_t skipped = 0;
-      mvog::Scan scan = convert(skipped);
+      SensorReadings readings(convert(skipped));
       context_.counters.readings_rejected += skipped;
-      context_.enqueue(std::move(scan), message_type);
+      context_.enqueue(std::move(readings), message_type);
     } catch (const InvalidMessage& e) {
       rejectMessage(message_type, e.what());
     }

@@ -20,7 +20,7 @@ class SensorInputs {
   /// `depth_no_return_length`: where those of depth images end (DepthImageConfig).
   SensorInputs(ros::NodeHandle nh, const SensorInputsConfig& config, const std::string& frame_id,
                double max_range, double depth_no_return_length, const tf2_ros::Buffer& tf_buffer,
-               EnqueueScan enqueue);
+               EnqueueReadings enqueue);
 
   /// ~max_range changed (RuntimeReconfigure): as the constructor's arguments, for the next
   /// message each input converts.

@@ -83,18 +83,20 @@ void DepthImageInput::receiveCameraInfo(const sensor_msgs::CameraInfoConstPtr& c
 void DepthImageInput::receivePair(const sensor_msgs::ImageConstPtr& image,
                                   const sensor_msgs::CameraInfoConstPtr& camera_info) {
   receive(image->header, [this, image, camera_info](const Eigen::Isometry3d& map_from_camera) {
-    convertAndEnqueue(*image, *camera_info, map_from_camera);
+    convertAndEnqueue(image, *camera_info, map_from_camera);
   });
 }
 
-void DepthImageInput::convertAndEnqueue(const sensor_msgs::Image& image,
+void DepthImageInput::convertAndEnqueue(const sensor_msgs::ImageConstPtr& image,
                                         const sensor_msgs::CameraInfo& camera_info,
                                         const Eigen::Isometry3d& map_from_camera) {
-  enqueueConverted("depth image", [&](std::size_t& skipped) {
+  // Checked here and inserted straight from its pixels (mvog::Map::insertDepthImage), which the
+  // insertion counts: no cloud of every pixel in between.
+  enqueueConverted("depth image", [&](std::size_t&) {
     const mvog::DepthImageConfig config{stride_, no_return_length_.load()};
-    return depthImageToScan(image, camera_info, map_from_camera, config,
-                            static_cast<std::size_t>(context_.config.max_points_per_message),
-                            skipped);
+    return DepthImageReadings{
+        image, depthFrameOf(*image, camera_info, map_from_camera, config,
+                            static_cast<std::size_t>(context_.config.max_points_per_message))};
   });
 }
 

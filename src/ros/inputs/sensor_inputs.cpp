@@ -11,7 +11,7 @@ namespace mvog_ros {
 SensorInputs::SensorInputs(ros::NodeHandle nh, const SensorInputsConfig& config,
                            const std::string& frame_id, double max_range,
                            double depth_no_return_length, const tf2_ros::Buffer& tf_buffer,
-                           EnqueueScan enqueue) {
+                           EnqueueReadings enqueue) {
   const SensorInputContext context{config, frame_id, tf_buffer, counters_, std::move(enqueue)};
   std::vector<std::string> scan_topics{"scan"};
   scan_topics.insert(scan_topics.end(), config.scan_topics.begin(), config.scan_topics.end());
