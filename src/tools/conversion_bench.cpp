@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 
 #include "mvog/depth_image.h"
+#include "mvog/map.h"
 #include "mvog_ros/conversions.h"
 #include "mvog_scene/scene.h"
 
@@ -130,6 +131,38 @@ void BM_DepthImageToScan(benchmark::State& state, const char* encoding) {
 }
 BENCHMARK_CAPTURE(BM_DepthImageToScan, 16UC1, "16UC1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_DepthImageToScan, 32FC1, "32FC1")->Unit(benchmark::kMillisecond);
+
+/// A depth image into a map of 0.05 m (the same frame again and again, the map kept): straight
+/// from its pixels (as the server does), or through a Scan of every pixel (as it did).
+void BM_InsertDepthImage(benchmark::State& state, const char* encoding, bool straight) {
+  const sensor_msgs::Image image = depthImage(encoding);
+  const sensor_msgs::CameraInfo info = cameraInfo();
+  const Eigen::Isometry3d pose = cameraPose();
+  mvog::MapConfig config;
+  config.resolution = 0.05;
+  mvog::Map map(config);
+  mvog::InsertionResult result;
+  for (auto _ : state) {
+    if (straight) {
+      result = map.insertDepthImage(
+          mvog_ros::depthFrameOf(image, info, pose, mvog::DepthImageConfig{}, kNoLimit));
+    } else {
+      std::size_t skipped = 0;
+      result = map.insertScan(mvog_ros::depthImageToScan(
+          image, info, pose, mvog::DepthImageConfig{}, kNoLimit, skipped));
+    }
+  }
+  countPixels(state);
+  state.counters["rays_walked"] = static_cast<double>(result.rays_walked);
+}
+BENCHMARK_CAPTURE(BM_InsertDepthImage, straight 16UC1, "16UC1", true)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_InsertDepthImage, through a Scan 16UC1, "16UC1", false)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_InsertDepthImage, straight 32FC1, "32FC1", true)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_InsertDepthImage, through a Scan 32FC1, "32FC1", false)
+    ->Unit(benchmark::kMillisecond);
 
 /// The cloud path, first half: the image back-projected into an organised PointCloud2.
 void BM_DepthImageToCloud(benchmark::State& state) {
