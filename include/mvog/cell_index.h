@@ -17,10 +17,16 @@ struct CellIndex {
   friend bool operator!=(const CellIndex& a, const CellIndex& b) { return !(a == b); }
 };
 
-/// The cell that grid coordinate (gx, gy) = s * (x, y) projects onto.
-inline CellIndex cellAt(double gx, double gy) {
-  return {static_cast<std::int32_t>(std::floor(gx)), static_cast<std::int32_t>(std::floor(gy))};
+/// floor(g) as an index, for g whose floor an int32 holds: static_cast<std::int32_t>(std::floor(g))
+/// without floor's call (SSE2 has no rounding instruction): the conversion truncates toward
+/// zero, one too high for a negative g that is not an integer.
+inline std::int32_t floorToIndex(double g) {
+  const auto truncated = static_cast<std::int32_t>(g);
+  return truncated - static_cast<std::int32_t>(g < static_cast<double>(truncated));
 }
+
+/// The cell that grid coordinate (gx, gy) = s * (x, y) projects onto.
+inline CellIndex cellAt(double gx, double gy) { return {floorToIndex(gx), floorToIndex(gy)}; }
 
 /// An inclusive rectangle of cells.
 struct CellRange {

@@ -45,8 +45,7 @@ void EndVoxelRays::grow() {
   }
 }
 
-void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end,
-                                  const Volume* hit) {
+void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end) {
   last_ = voxel;
   const std::uint32_t tag = stamp_ << 1 | static_cast<std::uint32_t>(voxel.obstacle);
   if (2 * (voxels_.size() + 1) > slots_.size()) grow();
@@ -57,7 +56,7 @@ void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& 
     if (slot.tag >> 1 != stamp_) break;
     if (slot.tag == tag && slot.x == voxel.x && slot.y == voxel.y && slot.z == voxel.z) {
       last_index_ = slot.index;
-      join(voxels_[last_index_], voxel, end, hit);
+      join(voxels_[last_index_], voxel, end);
       return;
     }
   }
@@ -68,48 +67,10 @@ void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& 
                      end,
                      centreDistance(voxel, end),
                      {voxel.x, voxel.y},
-                     hit != nullptr ? hit->bottom : 0.0f,
-                     hit != nullptr ? hit->top : 0.0f,
+                     static_cast<float>(end.z()),
+                     static_cast<float>(end.z()),
                      1,
                      voxel.obstacle});
-}
-
-/// Checks one reading and counts it in `result`; on acceptance sets the ray's end (truncated to
-/// max_range) and whether it ends in an obstacle. `origin_accepted`: the scan's origin is within
-/// the map's bounds (checked once a scan).
-bool acceptReading(const Eigen::Vector3d& origin, bool origin_accepted, const Eigen::Vector3d& end,
-                   ReadingKind kind, const MapConfig& map_config, const InsertionConfig& config,
-                   Eigen::Vector3d& ray_end, bool& obstacle, InsertionResult& result) {
-  const bool is_obstacle = kind == ReadingKind::kObstacle;
-  if (!origin_accepted || !map_config.withinBounds(end)) {
-    if (!origin.allFinite() || !end.allFinite()) {
-      ++result.rejected_non_finite;
-    } else {
-      ++result.rejected_out_of_bounds;
-    }
-    return false;
-  }
-  const Eigen::Vector3d ray = end - origin;
-  const double length = ray.norm();
-  // A zero-length out-of-range reading carries no free space; a zero-length hit is below any
-  // min_range but the sensor itself (decision: both are dropped as too close).
-  if (length == 0.0 || (is_obstacle && length < config.min_range)) {
-    ++result.rejected_too_close;
-    return false;
-  }
-  obstacle = is_obstacle && length <= config.max_range;
-  if (!obstacle && !config.insert_out_of_range) {
-    ++result.ignored_out_of_range;
-    return false;
-  }
-  ray_end = freeEnd(origin, end, length, freeLengthOf(kind, map_config, config));
-  if (obstacle) {
-    ++result.obstacle_readings;
-  } else {
-    ++result.out_of_range_readings;
-    if (is_obstacle) ++result.truncated_to_max_range;
-  }
-  return true;
 }
 
 namespace {
@@ -182,12 +143,7 @@ GroupedScan groupReadings(const Readings& readings, const Eigen::Vector3d& origi
     }
     grouped.level = grouped.level && ray_end.z() == origin.z();
     const Eigen::Vector3d end_cells = ray_end * s;
-    if (obstacle) {
-      const Volume hit = hitVolume(static_cast<float>(end_cells.z()));
-      voxels.offer(end_cells, &hit);
-    } else {
-      voxels.offer(end_cells, nullptr);
-    }
+    voxels.offer(end_cells, obstacle);
   };
   readings.forEach([&](const Eigen::Vector3f& p) { offer(p, ReadingKind::kObstacle); },
                    [&](const Eigen::Vector3f& p) { offer(p, ReadingKind::kOutOfRange); });

@@ -361,7 +361,7 @@ struct EndVoxel {
 /// The voxel `end` (grid units) lies in.
 inline EndVoxel endVoxelOf(const Eigen::Vector3d& end, bool obstacle) {
   const CellIndex cell = cellAt(end.x(), end.y());
-  return {cell.x, cell.y, static_cast<std::int32_t>(std::floor(end.z())), obstacle};
+  return {cell.x, cell.y, floorToIndex(end.z()), obstacle};
 }
 
 /// The fewest readings of a scan ending in one voxel for which one ray is walked
@@ -372,17 +372,21 @@ inline EndVoxel endVoxelOf(const Eigen::Vector3d& end, bool obstacle) {
 /// neighbour's ray frees what one of them alone does.
 constexpr std::uint32_t kReadingsForOneRay = 4;
 
+/// Eq. (5): a hit's positive volume, one cell high around its height `end_z` (grid units).
+inline Volume hitVolume(float end_z) { return makeVolume(end_z - 0.5f, end_z + 0.5f); }
+
 /// The readings of a scan ending in one voxel: their ends while fewer than kReadingsForOneRay
 /// (each walked), the end nearest the voxel's centre (the one walked for all from then on), and
-/// in an obstacle's voxel the union of their hits' volumes (eq. 5: each is a cell high and their
-/// heights are less than one apart, so that they overlap).
+/// in an obstacle's voxel the lowest and highest of their heights: the union of their hits'
+/// volumes (eq. 5: each is a cell high and their heights are less than one apart, so that they
+/// overlap) spans from the lowest's bottom to the highest's top (EndVoxelRays::hitsOf).
 struct VoxelReadings {
   std::array<Eigen::Vector3d, kReadingsForOneRay - 1> ends;  ///< the first ones, grid units
   Eigen::Vector3d nearest;
   double nearest_distance;  ///< squared, from `nearest` to the voxel's centre
   CellIndex cell;
-  float hits_bottom;  ///< the union of the hits' volumes (masses are not counted per scan)
-  float hits_top;
+  float lowest_hit;  ///< heights as hitVolume takes them (masses are not counted per scan)
+  float highest_hit;
   std::uint32_t count;
   bool obstacle;
 };
@@ -396,21 +400,24 @@ class alignas(kCacheLine) EndVoxelRays {
  public:
   /// Forgets the previous scan's voxels (their memory is kept).
   void begin();
-  /// A reading of the scan ending at `end` (grid units): in an obstacle, whose volume is `*hit`,
-  /// or not (`hit` null). Inline where it ends in the voxel of the reading before.
-  void offer(const Eigen::Vector3d& end, const Volume* hit) {
-    const EndVoxel voxel = endVoxelOf(end, hit != nullptr);
+  /// A reading of the scan ending at `end` (grid units), in an obstacle or not. Inline where it
+  /// ends in the voxel of the reading before.
+  void offer(const Eigen::Vector3d& end, bool obstacle) {
+    const EndVoxel voxel = endVoxelOf(end, obstacle);
     if (!voxels_.empty() && voxel == last_) {
-      join(voxels_[last_index_], voxel, end, hit);
+      join(voxels_[last_index_], voxel, end);
       return;
     }
-    offerElsewhere(voxel, end, hit);
+    offerElsewhere(voxel, end);
   }
   /// The voxels offered, in the order first offered.
   const std::vector<VoxelReadings>& voxels() const { return voxels_; }
-  /// The union of the hits' volumes of an obstacle's voxel.
+  /// The union of the hits' volumes of an obstacle's voxel. A hit's volume (hitVolume) is
+  /// exactly [z - 0.5, z + 0.5]: both sums are exact for a float of magnitude up to 2^22
+  /// (MapConfig's bound in cells), so its bottom and top grow with z.
   static Volume hitsOf(const VoxelReadings& voxel) {
-    return volumeOfMinimumHeight(voxel.hits_bottom, voxel.hits_top);
+    return volumeOfMinimumHeight(hitVolume(voxel.lowest_hit).bottom,
+                                 hitVolume(voxel.highest_hit).top);
   }
   /// Calls walk(end) for the ray of each of the voxel's readings to walk.
   template <class Walk>
@@ -432,15 +439,15 @@ class alignas(kCacheLine) EndVoxelRays {
     std::uint32_t index;  ///< in voxels_
   };
   /// offer() for a reading ending in another voxel than the reading before.
-  void offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end, const Volume* hit);
+  void offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end);
   /// Adds a reading of `voxel` to its readings.
-  static void join(VoxelReadings& readings, const EndVoxel& voxel, const Eigen::Vector3d& end,
-                   const Volume* hit) {
+  static void join(VoxelReadings& readings, const EndVoxel& voxel, const Eigen::Vector3d& end) {
     if (readings.count < readings.ends.size()) readings.ends[readings.count] = end;
     ++readings.count;
-    if (hit != nullptr) {
-      readings.hits_bottom = std::min(readings.hits_bottom, hit->bottom);
-      readings.hits_top = std::max(readings.hits_top, hit->top);
+    if (voxel.obstacle) {
+      const auto z = static_cast<float>(end.z());
+      readings.lowest_hit = std::min(readings.lowest_hit, z);
+      readings.highest_hit = std::max(readings.highest_hit, z);
     }
     const double distance = centreDistance(voxel, end);
     if (distance < readings.nearest_distance ||
@@ -497,15 +504,46 @@ inline Eigen::Vector3d freeEnd(const Eigen::Vector3d& origin, const Eigen::Vecto
                               : end;
 }
 
-/// Eq. (5): a hit's positive volume, one cell high around its height `end_z` (grid units).
-inline Volume hitVolume(float end_z) { return makeVolume(end_z - 0.5f, end_z + 0.5f); }
-
 /// Checks one reading and counts it in `result`; on acceptance sets the ray's end (truncated to
 /// max_range) and whether it ends in an obstacle. `origin_accepted`: the scan's origin is within
 /// the map's bounds (checked once a scan).
-bool acceptReading(const Eigen::Vector3d& origin, bool origin_accepted, const Eigen::Vector3d& end,
-                   ReadingKind kind, const MapConfig& map_config, const InsertionConfig& config,
-                   Eigen::Vector3d& ray_end, bool& obstacle, InsertionResult& result);
+[[gnu::always_inline]] inline bool acceptReading(const Eigen::Vector3d& origin,
+                                                 bool origin_accepted, const Eigen::Vector3d& end,
+                                                 ReadingKind kind, const MapConfig& map_config,
+                                                 const InsertionConfig& config,
+                                                 Eigen::Vector3d& ray_end, bool& obstacle,
+                                                 InsertionResult& result) {
+  const bool is_obstacle = kind == ReadingKind::kObstacle;
+  if (!origin_accepted || !map_config.withinBounds(end)) {
+    if (!origin.allFinite() || !end.allFinite()) {
+      ++result.rejected_non_finite;
+    } else {
+      ++result.rejected_out_of_bounds;
+    }
+    return false;
+  }
+  const Eigen::Vector3d ray = end - origin;
+  const double length = ray.norm();
+  // A zero-length out-of-range reading carries no free space; a zero-length hit is below any
+  // min_range but the sensor itself (decision: both are dropped as too close).
+  if (length == 0.0 || (is_obstacle && length < config.min_range)) {
+    ++result.rejected_too_close;
+    return false;
+  }
+  obstacle = is_obstacle && length <= config.max_range;
+  if (!obstacle && !config.insert_out_of_range) {
+    ++result.ignored_out_of_range;
+    return false;
+  }
+  ray_end = freeEnd(origin, end, length, freeLengthOf(kind, map_config, config));
+  if (obstacle) {
+    ++result.obstacle_readings;
+  } else {
+    ++result.out_of_range_readings;
+    if (is_obstacle) ++result.truncated_to_max_range;
+  }
+  return true;
+}
 
 /// What grouping a scan's readings by end voxel learnt of them all (groupByEndVoxel).
 struct GroupedScan {

@@ -53,6 +53,25 @@ void expectChained(const std::vector<Step>& steps, double z_start, double z_end)
   }
 }
 
+TEST(CellAt, FloorsEveryCoordinateAsStdFloorDoes) {
+  // floorToIndex converts without a call to floor: the same cell for integers, non-integers of
+  // either sign, -0, values a float-rounding away from an integer, and the grid's bounds.
+  const double step = std::nextafter(1.0, 2.0) - 1.0;
+  std::vector<double> values = {0.0,    -0.0,       0.5,          -0.5,         1.0,
+                                -1.0,   1.0 - step, -1.0 + step,  -1.0 - step,  2.5,
+                                -2.5,   4194304.0,  -4194304.0,   4194303.75,   -4194303.75,
+                                1e-300, -1e-300,    2147483647.0, -2147483648.0};
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> any(-5e6, 5e6);
+  for (int k = 0; k < 100000; ++k) values.push_back(any(random));
+  for (const double g : values) {
+    EXPECT_EQ(floorToIndex(g), static_cast<std::int32_t>(std::floor(g))) << g;
+    EXPECT_EQ(cellAt(g, -g), (CellIndex{static_cast<std::int32_t>(std::floor(g)),
+                                        static_cast<std::int32_t>(std::floor(-g))}))
+        << g;
+  }
+}
+
 TEST(WalkRay, AlongPlusX) {
   // From x = 0.5 to 3.5 rising 0 -> 3: the walls x = 1, 2, 3 are met at z = 0.5, 1.5, 2.5.
   const std::vector<Step> steps = walk(0.5, 0.5, 0.0, 3.5, 0.5, 3.0);

@@ -186,7 +186,8 @@ TEST_F(InsertionWorkerTest, DepthImagesGoInStraightFromTheirPixelsAsTheirScansWo
   // Queued as images (no Scan of their pixels), on one thread or on the backlog's four: the map
   // of inserting each image's Scan one by one, the pixels without a measurement counted.
   std::vector<DepthImageReadings> images;
-  for (std::uint32_t k = 0; k < 6; ++k) images.push_back(depthImageOfAWall(3.0f + 0.1f * k, k));
+  for (std::uint32_t k = 0; k < 6; ++k)
+    images.push_back(depthImageOfAWall(3.0f + 0.1f * static_cast<float>(k), k));
   mvog::Map one_by_one(mapConfig());
   std::size_t skipped_total = 0;
   for (const DepthImageReadings& image : images) {
