@@ -67,7 +67,7 @@ Scan backProjectDepthImage(const DepthFrame& frame, std::size_t& skipped_pixels)
   skipped_pixels = 0;
   scan.hits.reserve(keptPixels(frame.image, frame.config));
   detail::forEachDepthReading(
-      frame, [&](const Eigen::Vector3f& p) { scan.hits.push_back(p); },
+      frame, 0, frame.image.height, [&](const Eigen::Vector3f& p) { scan.hits.push_back(p); },
       [&](const Eigen::Vector3f& p) { scan.out_of_range.push_back(p); }, skipped_pixels);
   return scan;
 }

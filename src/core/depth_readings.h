@@ -26,11 +26,12 @@ inline Eigen::Vector3f toFloat(const Eigen::Vector3d& p) {
 
 /// Calls hit(p) for each kept pixel of `frame` (validated) with a finite depth > 0, and
 /// out_of_range(p) for each +Inf pixel when config.no_return_length is finite, p its reading
-/// in the map frame (float, as a Scan holds it), row by row; counts the other kept pixels in
-/// `skipped` (REP-118: 0, NaN, negative and -Inf say nothing).
+/// in the map frame (float, as a Scan holds it), row by row from row `first_row` to `end_row`
+/// (those the stride keeps); counts the other kept pixels in `skipped` (REP-118: 0, NaN,
+/// negative and -Inf say nothing).
 template <class Hit, class OutOfRange>
-void forEachDepthReading(const DepthFrame& frame, Hit&& hit, OutOfRange&& out_of_range,
-                         std::size_t& skipped) {
+void forEachDepthReading(const DepthFrame& frame, std::size_t first_row, std::size_t end_row,
+                         Hit&& hit, OutOfRange&& out_of_range, std::size_t& skipped) {
   const DepthImageView& image = frame.image;
   const PinholeCamera& camera = frame.camera;
   const bool millimetres = image.encoding == DepthEncoding::kUint16Millimetres;
@@ -46,7 +47,7 @@ void forEachDepthReading(const DepthFrame& frame, Hit&& hit, OutOfRange&& out_of
   const auto stride = static_cast<std::size_t>(frame.config.stride);
   const std::size_t pixel_bytes = DepthImageView::bytesPerPixel(image.encoding);
   const Eigen::Isometry3d& map_from_camera = frame.map_from_camera;
-  for (std::size_t v = 0; v < image.height; v += stride) {
+  for (std::size_t v = (first_row + stride - 1) / stride * stride; v < end_row; v += stride) {
     const std::uint8_t* row = image.data + v * image.step;
     for (std::size_t u = 0; u < image.width; u += stride) {
       float depth = 0.0f;  // in the image's unit

@@ -45,8 +45,7 @@ void EndVoxelRays::grow() {
   }
 }
 
-void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end) {
-  last_ = voxel;
+std::pair<std::uint32_t, bool> EndVoxelRays::findOrAdd(const EndVoxel& voxel) {
   const std::uint32_t tag = stamp_ << 1 | static_cast<std::uint32_t>(voxel.obstacle);
   if (2 * (voxels_.size() + 1) > slots_.size()) grow();
   const std::size_t mask = slots_.size() - 1;
@@ -55,14 +54,23 @@ void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& 
     const Slot& slot = slots_[k];
     if (slot.tag >> 1 != stamp_) break;
     if (slot.tag == tag && slot.x == voxel.x && slot.y == voxel.y && slot.z == voxel.z) {
-      last_index_ = slot.index;
-      join(voxels_[last_index_], voxel, end);
-      return;
+      return {slot.index, false};
     }
   }
   // A scan holds fewer than 2^32 readings.
-  last_index_ = static_cast<std::uint32_t>(voxels_.size());
-  slots_[k] = {voxel.x, voxel.y, voxel.z, tag, last_index_};
+  const auto index = static_cast<std::uint32_t>(voxels_.size());
+  slots_[k] = {voxel.x, voxel.y, voxel.z, tag, index};
+  return {index, true};
+}
+
+void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end) {
+  last_ = voxel;
+  const auto [index, added] = findOrAdd(voxel);
+  last_index_ = index;
+  if (!added) {
+    join(voxels_[index], voxel, end);
+    return;
+  }
   voxels_.push_back({{end},
                      end,
                      centreDistance(voxel, end),
@@ -73,36 +81,67 @@ void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& 
                      voxel.obstacle});
 }
 
+void EndVoxelRays::merge(const EndVoxelRays& other) {
+  for (const VoxelReadings& readings : other.voxels_) {
+    // Every reading of a voxel ends in it: `nearest` names it.
+    const auto [index, added] = findOrAdd(endVoxelOf(readings.nearest, readings.obstacle));
+    if (added) {
+      voxels_.push_back(readings);
+      continue;
+    }
+    VoxelReadings& into = voxels_[index];
+    // The ends are kept while a voxel holds fewer than kReadingsForOneRay readings: then both
+    // parts hold all theirs.
+    for (std::uint32_t k = 0; k < readings.count && into.count + k < into.ends.size(); ++k) {
+      into.ends[into.count + k] = readings.ends[k];
+    }
+    into.count += readings.count;
+    into.lowest_hit = std::min(into.lowest_hit, readings.lowest_hit);
+    into.highest_hit = std::max(into.highest_hit, readings.highest_hit);
+    keepNearer(into, readings.nearest, readings.nearest_distance);
+  }
+}
+
 namespace {
 
-/// A scan's readings from its points (Scan): calls hit(p) for each obstacle reading, then
-/// out_of_range(p) for each out-of-range reading.
+/// The `part`-th of `parts` runs of a scan's readings from its points (Scan): calls hit(p) for
+/// each of its obstacle readings, then out_of_range(p) for each of its out-of-range readings.
 struct ScanReadings {
   const Scan& scan;
+  std::size_t part;
+  std::size_t parts;
   template <class Hit, class OutOfRange>
   void forEach(Hit&& hit, OutOfRange&& out_of_range) const {
-    for (const Eigen::Vector3f& p : scan.hits) hit(p);
-    for (const Eigen::Vector3f& p : scan.out_of_range) out_of_range(p);
+    const std::size_t hits = scan.hits.size();
+    for (std::size_t k = hits * part / parts; k < hits * (part + 1) / parts; ++k) {
+      hit(scan.hits[k]);
+    }
+    const std::size_t out_of_range_readings = scan.out_of_range.size();
+    for (std::size_t k = out_of_range_readings * part / parts;
+         k < out_of_range_readings * (part + 1) / parts; ++k) {
+      out_of_range(scan.out_of_range[k]);
+    }
   }
 };
 
-/// A scan's readings straight from a depth image's pixels (DepthFrame, validated), the pixels
-/// without a measurement counted in `skipped`. They are passed on a batch at a time, from a
-/// buffer: GCC 12's SLP vectoriser at -O3 drops a point's rounding to float where it is rounded
-/// and widened back at once (its map then differs from its Scan's: test
-/// InsertDepthImage.MakesTheMapOfTheImagesReadingsBitForBitWhateverTheThreadsAndOptions).
+/// The `part`-th of `parts` runs of rows of a depth image (DepthFrame, validated), read straight
+/// from its pixels, the pixels without a measurement counted in `skipped`. They are passed on a
+/// batch at a time, from a buffer: GCC 12's SLP vectoriser at -O3 drops a point's rounding to
+/// float where it is rounded and widened back at once (its map then differs from its Scan's:
+/// test InsertDepthImage.MakesTheMapOfTheImagesReadingsBitForBitWhateverTheThreadsAndOptions).
 struct DepthFrameReadings {
   const DepthFrame& frame;
+  std::size_t part;
+  std::size_t parts;
   std::size_t& skipped;
-  /// Readings of the frame not yet passed on, and whether each is a hit.
-  std::vector<Eigen::Vector3f>& points;
-  std::vector<bool>& hits;
 
   template <class Hit, class OutOfRange>
   void forEach(Hit&& hit, OutOfRange&& out_of_range) const {
     constexpr std::size_t kBatch = 256;  // 3 KB of points, in the first-level cache
-    points.clear();
-    hits.clear();
+    std::vector<Eigen::Vector3f> points;
+    std::vector<bool> hits;
+    points.reserve(kBatch);
+    hits.reserve(kBatch);
     auto pass_on = [&] {
       for (std::size_t k = 0; k < points.size(); ++k) {
         if (hits[k]) {
@@ -119,8 +158,10 @@ struct DepthFrameReadings {
       hits.push_back(is_hit);
       if (points.size() == kBatch) pass_on();
     };
+    const std::size_t rows = frame.image.height;
     forEachDepthReading(
-        frame, [&](const Eigen::Vector3f& p) { keep(p, true); },
+        frame, rows * part / parts, rows * (part + 1) / parts,
+        [&](const Eigen::Vector3f& p) { keep(p, true); },
         [&](const Eigen::Vector3f& p) { keep(p, false); }, skipped);
     pass_on();
   }
@@ -152,24 +193,59 @@ GroupedScan groupReadings(const Readings& readings, const Eigen::Vector3d& origi
   return grouped;
 }
 
+/// groupByEndVoxel of the readings `readings_of(part, parts)` gives, each of `parts` runs on
+/// a thread of `pool`, into voxels[part], then merged into voxels[0].
+template <class ReadingsOf>
+GroupedScan groupInParts(const ReadingsOf& readings_of, const Eigen::Vector3d& origin,
+                         const MapConfig& map_config, const InsertionConfig& insertion,
+                         ThreadPool* pool, std::vector<EndVoxelRays>& voxels,
+                         InsertionResult& result) {
+  const std::size_t parts = pool != nullptr ? pool->threads() : 1;
+  if (voxels.size() < parts) voxels.resize(parts);
+  std::vector<GroupedScan> grouped(parts);
+  std::vector<InsertionResult> results(parts);
+  auto group = [&](std::size_t, std::size_t part) {
+    voxels[part].begin();
+    grouped[part] = groupReadings(readings_of(part, parts), origin, map_config, insertion,
+                                  voxels[part], results[part]);
+  };
+  if (pool != nullptr) {
+    pool->run(parts, group);
+  } else {
+    group(0, 0);
+  }
+  for (std::size_t part = 1; part < parts; ++part) {
+    voxels[0].merge(voxels[part]);
+    grouped[0].cells.extend(grouped[part].cells);
+    grouped[0].level = grouped[0].level && grouped[part].level;
+  }
+  for (const InsertionResult& r : results) result += r;
+  return grouped[0];
+}
+
 }  // namespace
 
 GroupedScan groupByEndVoxel(const Scan& scan, const MapConfig& map_config,
-                            const InsertionConfig& insertion, EndVoxelRays& voxels,
-                            InsertionResult& result) {
-  return groupReadings(ScanReadings{scan}, scan.origin, map_config, insertion, voxels, result);
+                            const InsertionConfig& insertion, ThreadPool* pool,
+                            std::vector<EndVoxelRays>& voxels, InsertionResult& result) {
+  return groupInParts(
+      [&](std::size_t part, std::size_t parts) {
+        return ScanReadings{scan, part, parts};
+      },
+      scan.origin, map_config, insertion, pool, voxels, result);
 }
 
 GroupedScan groupByEndVoxel(const DepthFrame& frame, const MapConfig& map_config,
-                            const InsertionConfig& insertion, EndVoxelRays& voxels,
-                            InsertionResult& result) {
-  std::size_t skipped = 0;
-  std::vector<Eigen::Vector3f> points;
-  std::vector<bool> hits;
-  const GroupedScan grouped =
-      groupReadings(DepthFrameReadings{frame, skipped, points, hits},
-                    frame.map_from_camera.translation(), map_config, insertion, voxels, result);
-  result.rejected_no_measurement += skipped;
+                            const InsertionConfig& insertion, ThreadPool* pool,
+                            std::vector<EndVoxelRays>& voxels, InsertionResult& result) {
+  const std::size_t parts = pool != nullptr ? pool->threads() : 1;
+  std::vector<std::size_t> skipped(parts, 0);
+  const GroupedScan grouped = groupInParts(
+      [&](std::size_t part, std::size_t count) {
+        return DepthFrameReadings{frame, part, count, skipped[part]};
+      },
+      frame.map_from_camera.translation(), map_config, insertion, pool, voxels, result);
+  for (std::size_t count : skipped) result.rejected_no_measurement += count;
   return grouped;
 }
 

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <memory>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "mvog/constraints.h"
@@ -412,6 +413,9 @@ class alignas(kCacheLine) EndVoxelRays {
   }
   /// The voxels offered, in the order first offered.
   const std::vector<VoxelReadings>& voxels() const { return voxels_; }
+  /// Adds the readings of `other`'s voxels (another part of the scan's readings): the voxels of
+  /// offering both parts' readings to one set, the same rays to walk, whatever the split.
+  void merge(const EndVoxelRays& other);
   /// The union of the hits' volumes of an obstacle's voxel. A hit's volume (hitVolume) is
   /// exactly [z - 0.5, z + 0.5]: both sums are exact for a float of magnitude up to 2^22
   /// (MapConfig's bound in cells), so its bottom and top grow with z.
@@ -449,7 +453,11 @@ class alignas(kCacheLine) EndVoxelRays {
       readings.lowest_hit = std::min(readings.lowest_hit, z);
       readings.highest_hit = std::max(readings.highest_hit, z);
     }
-    const double distance = centreDistance(voxel, end);
+    keepNearer(readings, end, centreDistance(voxel, end));
+  }
+  /// Makes `end`, `distance` from the voxel's centre, the readings' nearest if it is nearer, or
+  /// as near and lower in x, then y, then z: an order in which no two ends tie.
+  static void keepNearer(VoxelReadings& readings, const Eigen::Vector3d& end, double distance) {
     if (distance < readings.nearest_distance ||
         (distance == readings.nearest_distance &&
          std::lexicographical_compare(end.data(), end.data() + 3, readings.nearest.data(),
@@ -458,6 +466,8 @@ class alignas(kCacheLine) EndVoxelRays {
       readings.nearest_distance = distance;
     }
   }
+  /// The index of `voxel` in voxels_, and whether it is new (then voxels_ gets it next).
+  std::pair<std::uint32_t, bool> findOrAdd(const EndVoxel& voxel);
   /// The squared distance from `end` to the centre of its voxel.
   static double centreDistance(const EndVoxel& voxel, const Eigen::Vector3d& end) {
     return (end - Eigen::Vector3d(voxel.x + 0.5, voxel.y + 0.5, voxel.z + 0.5)).squaredNorm();
@@ -553,17 +563,18 @@ struct GroupedScan {
   bool level = true;
 };
 
-/// Checks and counts (in `result`) every reading of `scan`, and offers the accepted ones to
-/// `voxels` (begun), in one pass over them (FreeSpaceRays::kOnePerEndVoxel). Nothing is walked
-/// yet: the walks follow the voxels.
+/// Checks and counts (in `result`) every reading of `scan`, and groups the accepted ones by end
+/// voxel into voxels[0], in one pass over them (FreeSpaceRays::kOnePerEndVoxel); with `pool`,
+/// each of its threads a run of the readings into voxels[k], then merged into voxels[0] (the
+/// same voxels). Nothing is walked yet: the walks follow the voxels.
 GroupedScan groupByEndVoxel(const Scan& scan, const MapConfig& map_config,
-                            const InsertionConfig& insertion, EndVoxelRays& voxels,
-                            InsertionResult& result);
-/// The same straight from the pixels of a depth image (validated), the pixels without a
-/// measurement counted in result.rejected_no_measurement.
+                            const InsertionConfig& insertion, ThreadPool* pool,
+                            std::vector<EndVoxelRays>& voxels, InsertionResult& result);
+/// The same straight from the pixels of a depth image (validated), each thread a run of its
+/// rows, the pixels without a measurement counted in result.rejected_no_measurement.
 GroupedScan groupByEndVoxel(const DepthFrame& frame, const MapConfig& map_config,
-                            const InsertionConfig& insertion, EndVoxelRays& voxels,
-                            InsertionResult& result);
+                            const InsertionConfig& insertion, ThreadPool* pool,
+                            std::vector<EndVoxelRays>& voxels, InsertionResult& result);
 
 /// Whether a scan's free space is walked one ray per end voxel (FreeSpaceRays).
 inline bool walksOneRayPerEndVoxel(const MapConfig& map_config, const InsertionConfig& insertion) {
@@ -616,9 +627,10 @@ struct ScanUpdate::Impl {
   std::vector<detail::ScanScratch> scratches;
   /// Those of threads the last scan did not use, kept with their memory.
   std::vector<detail::ScanScratch> idle_scratches;
-  /// The scan's end voxels and their rays (FreeSpaceRays::kOnePerEndVoxel), grouped before the
-  /// chunks walk them.
-  detail::EndVoxelRays end_voxels;
+  /// The scan's end voxels and their rays (FreeSpaceRays::kOnePerEndVoxel): the first holds them
+  /// all once grouped (each thread groups a part of the readings into one), before the chunks
+  /// walk them.
+  std::vector<detail::EndVoxelRays> end_voxels;
   /// With several threads: the scratch of each reading of the scan (splitReadingsBySector).
   detail::ReadingSplit split;
   std::unique_ptr<detail::ThreadPool> pool;

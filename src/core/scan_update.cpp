@@ -553,9 +553,9 @@ void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
   }
   Impl& impl = *impl_;
   const auto began = std::chrono::steady_clock::now();
-  impl.end_voxels.begin();
   const detail::GroupedScan grouped =
-      detail::groupByEndVoxel(scan, map_config, insertion, impl.end_voxels, impl.result);
+      detail::groupByEndVoxel(scan, map_config, insertion, impl.threads(impl.scratches.size()),
+                              impl.end_voxels, impl.result);
   walkEndVoxels(scan.origin, grouped.cells, grouped.level, began);
 }
 
@@ -576,9 +576,9 @@ void ScanUpdate::prepare(const DepthFrame& frame, const MapConfig& map_config,
   begin(map_config, insertion);
   Impl& impl = *impl_;
   const auto began = std::chrono::steady_clock::now();
-  impl.end_voxels.begin();
   const detail::GroupedScan grouped =
-      detail::groupByEndVoxel(frame, map_config, insertion, impl.end_voxels, impl.result);
+      detail::groupByEndVoxel(frame, map_config, insertion, impl.threads(impl.scratches.size()),
+                              impl.end_voxels, impl.result);
   walkEndVoxels(frame.map_from_camera.translation(), grouped.cells, grouped.level, began);
 }
 
@@ -593,7 +593,7 @@ void ScanUpdate::walkEndVoxels(const Eigen::Vector3d& origin, const CellRange& c
   const std::size_t num_threads = impl.scratches.size();
   const Eigen::Vector3d start = origin * (1.0 / map_config.resolution);
   if (num_threads > 1) {
-    detail::splitEndVoxelsBySector(impl.end_voxels, start, num_threads, impl.split);
+    detail::splitEndVoxelsBySector(impl.end_voxels[0], start, num_threads, impl.split);
   }
   const CellRange tiles = detail::tilesOf(cells);
   const Volume level_volume = detail::levelRayVolume(static_cast<float>(start.z()));
@@ -608,10 +608,10 @@ void ScanUpdate::walkEndVoxels(const Eigen::Vector3d& origin, const CellRange& c
     scratch.begin(join_gap, false, tiles, level ? &level_volume : nullptr);
     if (level) {
       detail::ScanScratch::Writer<false, true> writer(scratch);
-      detail::rasterizeEndVoxels(impl.end_voxels, mine, start, writer, results[chunk]);
+      detail::rasterizeEndVoxels(impl.end_voxels[0], mine, start, writer, results[chunk]);
     } else {
       detail::ScanScratch::Writer<false> writer(scratch);
-      detail::rasterizeEndVoxels(impl.end_voxels, mine, start, writer, results[chunk]);
+      detail::rasterizeEndVoxels(impl.end_voxels[0], mine, start, writer, results[chunk]);
     }
   };
   if (detail::ThreadPool* pool = impl.threads(num_threads)) {
