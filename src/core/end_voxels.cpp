@@ -1,6 +1,7 @@
 // One ray per end voxel (FreeSpaceRays::kOnePerEndVoxel): a scan's readings checked, counted and
 // grouped by the voxel they end in, from its points or straight from a depth image's pixels.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -138,25 +139,23 @@ struct DepthFrameReadings {
   template <class Hit, class OutOfRange>
   void forEach(Hit&& hit, OutOfRange&& out_of_range) const {
     constexpr std::size_t kBatch = 256;  // 3 KB of points, in the first-level cache
-    std::vector<Eigen::Vector3f> points;
-    std::vector<bool> hits;
-    points.reserve(kBatch);
-    hits.reserve(kBatch);
+    std::array<Eigen::Vector3f, kBatch> points;
+    std::array<bool, kBatch> hits;
+    std::size_t kept = 0;
     auto pass_on = [&] {
-      for (std::size_t k = 0; k < points.size(); ++k) {
+      for (std::size_t k = 0; k < kept; ++k) {
         if (hits[k]) {
           hit(points[k]);
         } else {
           out_of_range(points[k]);
         }
       }
-      points.clear();
-      hits.clear();
+      kept = 0;
     };
     auto keep = [&](const Eigen::Vector3f& p, bool is_hit) {
-      points.push_back(p);
-      hits.push_back(is_hit);
-      if (points.size() == kBatch) pass_on();
+      points[kept] = p;
+      hits[kept] = is_hit;
+      if (++kept == kBatch) pass_on();
     };
     const std::size_t rows = frame.image.height;
     forEachDepthReading(
