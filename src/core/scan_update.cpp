@@ -9,7 +9,6 @@
 #include <cstring>
 #include <iterator>
 #include <limits>
-#include <optional>
 #include <utility>
 
 #include "mvog/depth_image.h"
