@@ -215,7 +215,7 @@ constexpr std::uint32_t kKinectHeight = 480;
 
 /// The camera 1.2 m above the floor looking along +x, pitched 10 degrees down and turned 30
 /// degrees: optical z forward, x right, y down.
-Eigen::Isometry3d cameraPose() {
+Eigen::Isometry3d kinectPose() {
   Eigen::Matrix3d looking_along_x;
   looking_along_x << 0, 0, 1, -1, 0, 0, 0, -1, 0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -324,7 +324,7 @@ TEST(InsertDepthImage, MakesTheMapOfTheImagesReadingsBitForBitWhateverTheThreads
       SCOPED_TRACE(std::string(c.name) + ", " + std::to_string(threads) + " threads");
       InsertionConfig insertion = c.insertion;
       insertion.insertion_threads = threads;
-      expectSameAsItsScan({c.image, kKinect, cameraPose(), c.config}, c.map, insertion);
+      expectSameAsItsScan({c.image, kKinect, kinectPose(), c.config}, c.map, insertion);
     }
   }
 }
@@ -335,7 +335,7 @@ TEST(InsertDepthImage, AWallAt1And4MetresAndA2cmPoleAt3MetresAreOccupiedAcrossTh
   for (const auto& [wall, pole_radius] : {std::pair{1.0, 0.0}, std::pair{4.0, 0.01}}) {
     SCOPED_TRACE("wall at " + std::to_string(wall) + " m");
     const auto image = sceneImage<float>(wall, 3.0, pole_radius, static_cast<float>(wall));
-    const DepthFrame frame{image.view, kKinect, cameraPose(), {}};
+    const DepthFrame frame{image.view, kKinect, kinectPose(), {}};
     MapConfig config;
     config.resolution = 0.05;
     Map map(config);
