@@ -60,7 +60,7 @@ TEST(CellAt, FloorsEveryCoordinateAsStdFloorDoes) {
   std::vector<double> values = {0.0,    -0.0,       0.5,          -0.5,         1.0,
                                 -1.0,   1.0 - step, -1.0 + step,  -1.0 - step,  2.5,
                                 -2.5,   4194304.0,  -4194304.0,   4194303.75,   -4194303.75,
-                                1e-300, -1e-300,    2147483647.0, -2147483648.0};
+                                1e-300, -1e-300,    2147483647.0, -2147483647.0};
   std::mt19937 random(3);
   std::uniform_real_distribution<double> any(-5e6, 5e6);
   for (int k = 0; k < 100000; ++k) values.push_back(any(random));
