@@ -497,7 +497,7 @@ InsertionResult Map::apply(ScanUpdate& update) {
   const float unit_mass = static_cast<float>(1.0 / mass_unit_);
   // InsertionConfig::evidence_limit in the unit masses are stored in (a scan's density 1 is
   // unit_mass).
-  const double max_density = impl.evidence_limit * unit_mass;
+  const double max_density = impl.insertion.appliedEvidenceLimit(impl.map_config.rules) * unit_mass;
   const auto exponent = static_cast<std::int32_t>(unit_exponent_);
   const std::size_t num_threads = impl.scratches.size();
   std::vector<ColumnWork>& work = impl.column_work;

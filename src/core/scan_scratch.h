@@ -619,9 +619,8 @@ struct alignas(kCacheLine) ColumnWork {
 
 struct ScanUpdate::Impl {
   MapConfig map_config;
-  InsertionConfig insertion;  ///< of the scan prepared
-  /// InsertionConfig::evidence_limit of the scan prepared (Map::apply bounds the columns with it).
-  double evidence_limit = std::numeric_limits<double>::infinity();
+  /// Of the scan prepared (Map::apply bounds the columns with its evidence limit).
+  InsertionConfig insertion;
   InsertionResult result;
   /// One per chunk of readings (one per thread).
   std::vector<detail::ScanScratch> scratches;

@@ -527,7 +527,6 @@ void ScanUpdate::begin(const MapConfig& map_config, const InsertionConfig& inser
   Impl& impl = *impl_;
   impl.map_config = map_config;
   impl.insertion = insertion;
-  impl.evidence_limit = insertion.appliedEvidenceLimit(map_config.rules);
   impl.result = InsertionResult{};
   const auto num_threads = static_cast<std::size_t>(insertion.insertion_threads);
   // A server switches between one thread and several as its queue backs up: the scratches of the
