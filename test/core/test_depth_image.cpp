@@ -344,26 +344,15 @@ TEST(InsertDepthImage, AWallAt1And4MetresAndA2cmPoleAt3MetresAreOccupiedAcrossTh
     EXPECT_LT(result.rays_walked, result.obstacle_readings / 5);
     std::size_t skipped = 0;
     const Scan scan = backProjectDepthImage(frame, skipped);
-    std::size_t occupied = 0;
-    std::size_t free_halfway = 0;
-    std::size_t pole = 0;
-    std::size_t pole_occupied = 0;
-    for (std::size_t k = 0; k < scan.hits.size(); ++k) {
-      const Eigen::Vector3d hit = scan.hits[k].cast<double>();
-      const bool is_occupied = test::stateAt(map, hit) == OccupancyState::kOccupied;
-      occupied += is_occupied;
-      free_halfway += test::stateAt(map, 0.5 * (scan.origin + hit)) == OccupancyState::kFree;
-      const std::uint32_t u = static_cast<std::uint32_t>(k % kKinectWidth);
-      if (pole_radius > 0.0 && sceneDepth(u, 0, wall, 3.0, pole_radius) < wall) {
-        ++pole;
-        pole_occupied += is_occupied;
-      }
-    }
-    EXPECT_EQ(occupied, scan.hits.size());
-    EXPECT_GE(100 * free_halfway, 99 * scan.hits.size());
+    const test::HitStates states = test::hitStates(map, scan, [&](std::size_t k) {
+      const auto u = static_cast<std::uint32_t>(k % kKinectWidth);
+      return pole_radius > 0.0 && sceneDepth(u, 0, wall, 3.0, pole_radius) < wall;
+    });
+    EXPECT_EQ(states.occupied, scan.hits.size());
+    EXPECT_GE(100 * states.free_midpoints, 99 * scan.hits.size());
     if (pole_radius > 0.0) {
-      EXPECT_GE(pole, 3u * kKinectHeight);
-      EXPECT_EQ(pole_occupied, pole);
+      EXPECT_GE(states.marked, 3u * kKinectHeight);
+      EXPECT_EQ(states.marked_occupied, states.marked);
     }
   }
 }

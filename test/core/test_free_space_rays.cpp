@@ -487,22 +487,12 @@ TEST(FreeSpaceRays, ADepthCameraKeepsEveryHitAndFreesItsRaysWithAFifthOfTheWalks
   every_reading.insertScan(scan, everyReading());
   EXPECT_LT(result.rays_walked, scan.hits.size() / 5);
 
-  std::size_t occupied_hits = 0;
-  std::size_t pole_pixels = 0;
-  std::size_t occupied_pole_pixels = 0;
-  std::size_t free_midpoints = 0;
-  for (std::size_t k = 0; k < scan.hits.size(); ++k) {
-    const Eigen::Vector3d hit = scan.hits[k].cast<double>();
-    const bool occupied = test::stateAt(one_ray, hit) == OccupancyState::kOccupied;
-    occupied_hits += occupied;
-    pole_pixels += image.pole[k];
-    occupied_pole_pixels += image.pole[k] && occupied;
-    free_midpoints += test::stateAt(one_ray, 0.5 * (scan.origin + hit)) == OccupancyState::kFree;
-  }
-  EXPECT_EQ(occupied_hits, scan.hits.size());
-  EXPECT_GT(pole_pixels, 1000u);
-  EXPECT_EQ(occupied_pole_pixels, pole_pixels);
-  EXPECT_GE(100 * free_midpoints, 99 * scan.hits.size());
+  const test::HitStates states =
+      test::hitStates(one_ray, scan, [&](std::size_t k) { return image.pole[k]; });
+  EXPECT_EQ(states.occupied, scan.hits.size());
+  EXPECT_GT(states.marked, 1000u);
+  EXPECT_EQ(states.marked_occupied, states.marked);
+  EXPECT_GE(100 * states.free_midpoints, 99 * scan.hits.size());
 
   const AgreementByKind agreement = compareWithEveryReading(
       "depth camera", pointsToCompare({scan}, 1, 0.05), one_ray, every_reading);

@@ -61,6 +61,30 @@ inline OccupancyState stateAt(const Map& map, const Eigen::Vector3d& point) {
   return map.occupancy(point).state(kDefaultOccupancyThreshold);
 }
 
+/// What a map says of a scan's hits: how many it calls occupied, how many of those `marked(k)`
+/// picks (hit k: a thin object's, say) there are and how many of them it calls occupied, and at
+/// how many rays' midpoints it calls free.
+struct HitStates {
+  std::size_t occupied = 0;
+  std::size_t marked = 0;
+  std::size_t marked_occupied = 0;
+  std::size_t free_midpoints = 0;
+};
+
+template <class Marked>
+HitStates hitStates(const Map& map, const Scan& scan, const Marked& marked) {
+  HitStates states;
+  for (std::size_t k = 0; k < scan.hits.size(); ++k) {
+    const Eigen::Vector3d hit = scan.hits[k].cast<double>();
+    const bool occupied = stateAt(map, hit) == OccupancyState::kOccupied;
+    states.occupied += occupied;
+    states.marked += marked(k);
+    states.marked_occupied += marked(k) && occupied;
+    states.free_midpoints += stateAt(map, 0.5 * (scan.origin + hit)) == OccupancyState::kFree;
+  }
+  return states;
+}
+
 /// Tolerance for heights and masses computed by hand in double from numbers stored as floats.
 constexpr double kTolerance = 1e-5;
 
