@@ -112,6 +112,19 @@ enum class FreeSpaceRays : std::uint8_t {
   /// too. With MassCounting::kPerReading every reading adds its own mass and every ray is
   /// walked.
   kOnePerEndVoxel,
+  /// kOnePerEndVoxel, and the rays of its voxels of 4 or more readings that end in one column
+  /// (and alike in being a hit or not) walked along one path: a run of them whose end heights
+  /// lie at most 2 cells apart follows the xy-path of its ray ending nearest the column's axis,
+  /// each cell before the column getting the hull of the run's lowest and highest rays' crossings
+  /// there (eq. 6 each). Rays from one origin whose end heights differ by d differ by at most d
+  /// where they cross a cell, and each crossing is a cell high or more: the rays between those
+  /// two fill that hull, and a scan's intervals a gap of kMaxMergeGap apart join. Rays that share
+  /// their path free exactly what each walked alone frees. In the column each ray keeps its own
+  /// last crossing (Fig. 3). Each of these rays ends near its voxel's centre, so that their paths
+  /// part by less than a cell at the column and less towards the origin; a depth camera's wall
+  /// puts tens of voxels in a column, whose walks become one. The readings of voxels of fewer
+  /// are walked each, as kOnePerEndVoxel does: a sparse sensor's rays part by up to a cell.
+  kOnePathPerEndColumn,
 };
 
 /// How readings are turned into volumes (Sec. III-B).
@@ -129,7 +142,7 @@ struct InsertionConfig {
   int insertion_threads = 1;
   /// See FreeSpaceRays (the README's decisions table: measured agreement with every reading's
   /// walk in BENCHMARKS.md).
-  FreeSpaceRays free_space_rays = FreeSpaceRays::kOnePerEndVoxel;
+  FreeSpaceRays free_space_rays = FreeSpaceRays::kOnePathPerEndColumn;
   /// Bounded evidence (OctoMap's clamping): after a scan's update of a column, a volume whose
   /// density (eq. 2) and the highest density of the other list's volumes it overlaps sum to more
   /// than this has its mass scaled down so that they sum to it (boundEvidence). A height then

@@ -48,13 +48,14 @@ struct InsertionResult {
   /// Pixels of a depth image without a measurement (0, NaN, negative, -Inf, or +Inf when
   /// DepthImageConfig::no_return_length is infinite: REP-118), inserted straight from the image.
   std::size_t rejected_no_measurement = 0;
-  /// Rays walked for free space: one per inserted reading, or one per end voxel
-  /// (FreeSpaceRays::kOnePerEndVoxel); not a count of readings.
+  /// Rays walked for free space: one per inserted reading, one per end voxel
+  /// (FreeSpaceRays::kOnePerEndVoxel), or one per run of an end column
+  /// (kOnePathPerEndColumn); not a count of readings.
   std::size_t rays_walked = 0;
   /// Time spent rasterising the obstacle readings and the out-of-range readings (thread time,
   /// summed over the insertion's threads): how much the readings without a return cost. With
-  /// FreeSpaceRays::kOnePerEndVoxel the rays of hits truncated to max_range, which share end
-  /// voxels with the out-of-range readings, are walked and timed with theirs.
+  /// one ray per end voxel or one path per end column the rays of hits truncated to max_range,
+  /// which share end voxels with the out-of-range readings, are walked and timed with theirs.
   double obstacle_seconds = 0.0;
   double out_of_range_seconds = 0.0;
 

@@ -31,7 +31,7 @@ class ScanUpdate {
   void prepare(const Scan& scan, const MapConfig& map_config, const InsertionConfig& insertion);
   /// Rasterises the depth image of `frame` straight from its pixels, as prepare() would a Scan
   /// of them (backProjectDepthImage): the same readings, the same map. With one ray per end
-  /// voxel (FreeSpaceRays::kOnePerEndVoxel, per-scan masses) no Scan is made; the pixels
+  /// voxel or one path per end column (FreeSpaceRays, per-scan masses) no Scan is made; the pixels
   /// without a measurement are counted in result().rejected_no_measurement. Throws ConfigError
   /// if a config, the image or the camera is invalid.
   void prepare(const DepthFrame& frame, const MapConfig& map_config,
@@ -47,8 +47,8 @@ class ScanUpdate {
   /// Validates the configs and readies the update's buffers for a scan.
   void begin(const MapConfig& map_config, const InsertionConfig& insertion);
   /// The hits and rays of the scan's end voxels (grouped since `grouping_began`), from `origin`,
-  /// into the scratches (FreeSpaceRays::kOnePerEndVoxel); `cells` and `level` as
-  /// detail::GroupedScan.
+  /// into the scratches (FreeSpaceRays::kOnePerEndVoxel or kOnePathPerEndColumn); `cells` and
+  /// `level` as detail::GroupedScan.
   void walkEndVoxels(const Eigen::Vector3d& origin, const CellRange& cells, bool level,
                      std::chrono::steady_clock::time_point grouping_began);
   /// Every reading's ray walked.

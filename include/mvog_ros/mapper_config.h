@@ -46,9 +46,9 @@ struct InsertionWorkerConfig : mvog::InsertionConfig {
   void validate() const;
 };
 
-/// ~free_space_rays: `one_per_end_voxel` (FreeSpaceRays::kOnePerEndVoxel, the default) or
-/// `every_reading` (FreeSpaceRays::kEveryReading). Throws mvog::ConfigError naming the parameter
-/// for any other name.
+/// ~free_space_rays: `one_path_per_end_column` (FreeSpaceRays::kOnePathPerEndColumn, the
+/// default), `one_per_end_voxel` (kOnePerEndVoxel) or `every_reading` (kEveryReading). Throws
+/// mvog::ConfigError naming the parameter for any other name.
 mvog::FreeSpaceRays freeSpaceRaysFromName(const std::string& name);
 
 /// Decay (Sec. III-E): masses times decay_factor every decay_period seconds.

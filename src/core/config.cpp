@@ -31,8 +31,9 @@ void InsertionConfig::validate() const {
   require(evidence_limit >= 1.0, "evidence_limit",
           "must be >= 1 (a scan's own density), infinity for no limit");
   require(free_space_rays == FreeSpaceRays::kEveryReading ||
-              free_space_rays == FreeSpaceRays::kOnePerEndVoxel,
-          "free_space_rays", "must be kEveryReading or kOnePerEndVoxel");
+              free_space_rays == FreeSpaceRays::kOnePerEndVoxel ||
+              free_space_rays == FreeSpaceRays::kOnePathPerEndColumn,
+          "free_space_rays", "must be kEveryReading, kOnePerEndVoxel or kOnePathPerEndColumn");
 }
 
 }  // namespace mvog

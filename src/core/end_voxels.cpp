@@ -1,8 +1,10 @@
 // One ray per end voxel (FreeSpaceRays::kOnePerEndVoxel): a scan's readings checked, counted and
-// grouped by the voxel they end in, from its points or straight from a depth image's pixels.
+// grouped by the voxel they end in, from its points or straight from a depth image's pixels; and
+// those rays by the column they end in (FreeSpaceRays::kOnePathPerEndColumn).
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "depth_readings.h"
@@ -12,12 +14,17 @@
 namespace mvog {
 namespace detail {
 
-void EndVoxelRays::begin() {
-  voxels_.clear();
+void EndVoxelIndex::begin() {
+  size_ = 0;
   if (++stamp_ == std::uint32_t{1} << 31) {  // the tag holds 31 bits of stamp: start again
     for (Slot& slot : slots_) slot.tag = 0;
     stamp_ = 1;
   }
+}
+
+void EndVoxelRays::begin() {
+  voxels_.clear();
+  index_.begin();
 }
 
 namespace {
@@ -31,14 +38,14 @@ std::size_t hashOf(std::int32_t x, std::int32_t y, std::int32_t z) {
 
 }  // namespace
 
-void EndVoxelRays::place(const Slot& slot) {
+void EndVoxelIndex::place(const Slot& slot) {
   const std::size_t mask = slots_.size() - 1;
   std::size_t k = hashOf(slot.x, slot.y, slot.z) & mask;
   while (slots_[k].tag >> 1 == stamp_) k = (k + 1) & mask;
   slots_[k] = slot;
 }
 
-void EndVoxelRays::grow() {
+void EndVoxelIndex::grow() {
   std::vector<Slot> old(std::max<std::size_t>(1024, 2 * slots_.size()), Slot{0, 0, 0, 0, 0});
   old.swap(slots_);
   for (const Slot& slot : old) {
@@ -46,9 +53,9 @@ void EndVoxelRays::grow() {
   }
 }
 
-std::pair<std::uint32_t, bool> EndVoxelRays::findOrAdd(const EndVoxel& voxel) {
+std::pair<std::uint32_t, bool> EndVoxelIndex::findOrAdd(const EndVoxel& voxel) {
   const std::uint32_t tag = stamp_ << 1 | static_cast<std::uint32_t>(voxel.obstacle);
-  if (2 * (voxels_.size() + 1) > slots_.size()) grow();
+  if (2 * (std::size_t{size_} + 1) > slots_.size()) grow();
   const std::size_t mask = slots_.size() - 1;
   std::size_t k = hashOf(voxel.x, voxel.y, voxel.z) & mask;
   for (;; k = (k + 1) & mask) {
@@ -59,14 +66,13 @@ std::pair<std::uint32_t, bool> EndVoxelRays::findOrAdd(const EndVoxel& voxel) {
     }
   }
   // A scan holds fewer than 2^32 readings.
-  const auto index = static_cast<std::uint32_t>(voxels_.size());
-  slots_[k] = {voxel.x, voxel.y, voxel.z, tag, index};
-  return {index, true};
+  slots_[k] = {voxel.x, voxel.y, voxel.z, tag, size_};
+  return {size_++, true};
 }
 
 void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end) {
   last_ = voxel;
-  const auto [index, added] = findOrAdd(voxel);
+  const auto [index, added] = index_.findOrAdd(voxel);
   last_index_ = index;
   if (!added) {
     join(voxels_[index], voxel, end);
@@ -85,7 +91,7 @@ void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& 
 void EndVoxelRays::merge(const EndVoxelRays& other) {
   for (const VoxelReadings& readings : other.voxels_) {
     // Every reading of a voxel ends in it: `nearest` names it.
-    const auto [index, added] = findOrAdd(endVoxelOf(readings.nearest, readings.obstacle));
+    const auto [index, added] = index_.findOrAdd(endVoxelOf(readings.nearest, readings.obstacle));
     if (added) {
       voxels_.push_back(readings);
       continue;
@@ -100,6 +106,60 @@ void EndVoxelRays::merge(const EndVoxelRays& other) {
     into.lowest_hit = std::min(into.lowest_hit, readings.lowest_hit);
     into.highest_hit = std::max(into.highest_hit, readings.highest_hit);
     keepNearer(into, readings.nearest, readings.nearest_distance);
+  }
+}
+
+void EndColumnRuns::formRuns(std::size_t voxels) {
+  // A counting sort by column: column_rays_ becomes where each column's ends start, then end.
+  std::uint32_t offset = 0;
+  for (std::uint32_t& count : column_rays_) offset += std::exchange(count, offset);
+  sorted_.resize(ends_.size());
+  for (const RayEnd& ray : ends_) sorted_[column_rays_[ray.column]++] = ray;
+  by_column_.resize(ends_.size());
+  runs_.clear();
+  run_of_first_voxel_.assign(voxels, kNoRun);
+  std::uint32_t first = 0;
+  for (const std::uint32_t end : column_rays_) {
+    if (end - first == 1) {  // most columns of most scans: a run of one ray
+      by_column_[first] = sorted_[first].end;
+      run_of_first_voxel_[sorted_[first].voxel] = static_cast<std::uint32_t>(runs_.size());
+      runs_.push_back({first, 1, 0});
+      first = end;
+      continue;
+    }
+    std::sort(sorted_.begin() + first, sorted_.begin() + end,
+              [](const RayEnd& a, const RayEnd& b) { return a.end.z() < b.end.z(); });
+    const CellIndex cell = cellAt(sorted_[first].end.x(), sorted_[first].end.y());
+    const Eigen::Vector2d axis(cell.x + 0.5, cell.y + 0.5);
+    Run run{first, 0, 0};
+    std::uint32_t first_voxel = sorted_[first].voxel;
+    double path_distance = 0.0;
+    auto close_run = [&] {
+      run_of_first_voxel_[first_voxel] = static_cast<std::uint32_t>(runs_.size());
+      runs_.push_back(run);
+    };
+    for (std::uint32_t k = first; k < end; ++k) {
+      const Eigen::Vector3d& ray_end = by_column_[k] = sorted_[k].end;
+      if (k > first && ray_end.z() - by_column_[k - 1].z() > kColumnRunHeightGap) {
+        close_run();
+        run = {k, 0, 0};
+        first_voxel = sorted_[k].voxel;
+      }
+      first_voxel = std::min(first_voxel, sorted_[k].voxel);
+      // The run follows the path of its end nearest the column's axis.
+      const double distance = (ray_end.head<2>() - axis).squaredNorm();
+      const Eigen::Vector3d& path = by_column_[run.first + run.path];
+      if (run.count == 0 || distance < path_distance ||
+          (distance == path_distance &&
+           std::lexicographical_compare(ray_end.data(), ray_end.data() + 3, path.data(),
+                                        path.data() + 3))) {
+        run.path = run.count;
+        path_distance = distance;
+      }
+      ++run.count;
+    }
+    close_run();
+    first = end;
   }
 }
 

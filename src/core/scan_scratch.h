@@ -392,11 +392,39 @@ struct VoxelReadings {
   bool obstacle;
 };
 
+/// A scan's end voxels (or columns: z = 0), each with the index it was added at (0, 1, ...): an
+/// open-addressing hash set kept from scan to scan, its slots stamped with their scan so that
+/// none needs clearing.
+class EndVoxelIndex {
+ public:
+  /// Forgets the previous scan's voxels (the memory is kept).
+  void begin();
+  /// The index of `voxel`, and whether it is new (then it gets the next index).
+  std::pair<std::uint32_t, bool> findOrAdd(const EndVoxel& voxel);
+
+ private:
+  struct Slot {
+    std::int32_t x;
+    std::int32_t y;
+    std::int32_t z;
+    /// The scan's stamp << 1 | obstacle; a slot of another scan is empty.
+    std::uint32_t tag;
+    std::uint32_t index;
+  };
+  /// Puts `slot` (not in the set) in its place.
+  void place(const Slot& slot);
+  /// Doubles the slots, keeping this scan's.
+  void grow();
+
+  std::vector<Slot> slots_;  ///< a power of two of them, at most half this scan's
+  std::uint32_t stamp_ = 0;  ///< 1 to 2^31 - 1
+  std::uint32_t size_ = 0;   ///< this scan's voxels
+};
+
 /// One thread's end voxels in a scan and their readings (FreeSpaceRays::kOnePerEndVoxel). The ray
 /// walked for a voxel of kReadingsForOneRay readings or more is that of the reading ending
 /// nearest its centre, ties to the lowest end in x, then y, then z, so that the choice does not
-/// depend on the readings' order. An open-addressing hash set kept from scan to scan, its slots
-/// stamped with their scan so that none needs clearing.
+/// depend on the readings' order. Kept from scan to scan with its memory.
 class alignas(kCacheLine) EndVoxelRays {
  public:
   /// Forgets the previous scan's voxels (their memory is kept).
@@ -434,14 +462,6 @@ class alignas(kCacheLine) EndVoxelRays {
   }
 
  private:
-  struct Slot {
-    std::int32_t x;
-    std::int32_t y;
-    std::int32_t z;
-    /// The scan's stamp << 1 | obstacle; a slot of another scan is empty.
-    std::uint32_t tag;
-    std::uint32_t index;  ///< in voxels_
-  };
   /// offer() for a reading ending in another voxel than the reading before.
   void offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end);
   /// Adds a reading of `voxel` to its readings.
@@ -466,20 +486,12 @@ class alignas(kCacheLine) EndVoxelRays {
       readings.nearest_distance = distance;
     }
   }
-  /// The index of `voxel` in voxels_, and whether it is new (then voxels_ gets it next).
-  std::pair<std::uint32_t, bool> findOrAdd(const EndVoxel& voxel);
   /// The squared distance from `end` to the centre of its voxel.
   static double centreDistance(const EndVoxel& voxel, const Eigen::Vector3d& end) {
     return (end - Eigen::Vector3d(voxel.x + 0.5, voxel.y + 0.5, voxel.z + 0.5)).squaredNorm();
   }
-  /// Puts `slot` (not in the set) in its place.
-  void place(const Slot& slot);
-  /// Doubles the slots, keeping this scan's.
-  void grow();
-
-  std::vector<Slot> slots_;  ///< a power of two of them, at most half this scan's
+  EndVoxelIndex index_;  ///< of voxels_
   std::vector<VoxelReadings> voxels_;
-  std::uint32_t stamp_ = 0;  ///< 1 to 2^31 - 1
   /// The voxel last offered, and its index: a depth image's neighbouring pixels mostly end in
   /// one.
   EndVoxel last_{};
@@ -555,6 +567,76 @@ inline Eigen::Vector3d freeEnd(const Eigen::Vector3d& origin, const Eigen::Vecto
   return true;
 }
 
+/// The most the end heights of two neighbouring rays of an end column's run may differ (grid
+/// units, FreeSpaceRays::kOnePathPerEndColumn). Rays from one origin whose end heights differ by
+/// d differ by at most d wherever they cross a cell, and each crossing is a cell high or more
+/// (eq. 6): their volumes there lie at most d - 1 apart, so that up to d = 1 + kMaxMergeGap a
+/// scan's intervals join (joinGapOf) and a run's crossings of a cell fill one interval.
+constexpr double kColumnRunHeightGap = 1.0 + kMaxMergeGap;
+
+/// The rays of one thread's end voxels of kReadingsForOneRay readings or more (each walks the
+/// ray of its reading nearest its centre) by the column they end in and whether they end in an
+/// obstacle, each column's in runs of neighbouring end heights
+/// (FreeSpaceRays::kOnePathPerEndColumn). Kept from scan to scan with its memory.
+class EndColumnRuns {
+ public:
+  /// The rays of the voxels k of `voxels` for which mine(k), of kReadingsForOneRay readings or
+  /// more, in runs.
+  template <class Mine>
+  void gather(const std::vector<VoxelReadings>& voxels, const Mine& mine) {
+    columns_.begin();
+    column_rays_.clear();
+    ends_.clear();
+    for (std::size_t k = 0; k < voxels.size(); ++k) {
+      const VoxelReadings& voxel = voxels[k];
+      if (voxel.count < kReadingsForOneRay || !mine(k)) continue;
+      const std::uint32_t column =
+          columns_.findOrAdd({voxel.cell.x, voxel.cell.y, 0, voxel.obstacle}).first;
+      if (column == column_rays_.size()) column_rays_.push_back(0);
+      ends_.push_back({voxel.nearest, static_cast<std::uint32_t>(k), column});
+      ++column_rays_[column];
+    }
+    formRuns(voxels.size());
+  }
+  /// Calls walk(ends, count, path) for the run whose first voxel (of those gathered) is voxel
+  /// `k`, if it is one's: ends[0, count) sorted by height, ends[path] the one ending nearest
+  /// the column's axis (ties to the lowest end in x, then y, then z). A run is walked where its
+  /// first voxel's ray would be: a scan's neighbouring readings' walks then mostly grow one
+  /// interval of a cell, as each voxel's own walk would.
+  template <class Walk>
+  void walkRunFrom(std::size_t k, Walk&& walk) const {
+    const std::uint32_t index = run_of_first_voxel_[k];
+    if (index == kNoRun) return;
+    const Run& run = runs_[index];
+    walk(by_column_.data() + run.first, run.count, run.path);
+  }
+
+ private:
+  /// A ray's end, its voxel's index and its column's.
+  struct RayEnd {
+    Eigen::Vector3d end;
+    std::uint32_t voxel;
+    std::uint32_t column;
+  };
+  struct Run {
+    std::uint32_t first;  ///< in by_column_
+    std::uint32_t count;
+    std::uint32_t path;  ///< the ray whose path the run follows, from first
+  };
+  static constexpr std::uint32_t kNoRun = ~std::uint32_t{0};
+  /// Sorts ends_ by column and end height into by_column_, and finds the runs and their first
+  /// of the `voxels` voxels.
+  void formRuns(std::size_t voxels);
+
+  EndVoxelIndex columns_;  ///< the columns of the rays' ends (z = 0), and whether they end in a hit
+  std::vector<std::uint32_t> column_rays_;  ///< by column: how many rays end there, then where
+  std::vector<RayEnd> ends_;                ///< in the voxels' order
+  std::vector<RayEnd> sorted_;              ///< by column, then height
+  std::vector<Eigen::Vector3d> by_column_;  ///< the ends of sorted_
+  std::vector<Run> runs_;
+  std::vector<std::uint32_t> run_of_first_voxel_;  ///< by voxel: the run it is the first of
+};
+
 /// What grouping a scan's readings by end voxel learnt of them all (groupByEndVoxel).
 struct GroupedScan {
   /// The cells of the origin and of every accepted reading's end: every walk stays within them.
@@ -579,7 +661,7 @@ GroupedScan groupByEndVoxel(const DepthFrame& frame, const MapConfig& map_config
 /// Whether a scan's free space is walked one ray per end voxel (FreeSpaceRays).
 inline bool walksOneRayPerEndVoxel(const MapConfig& map_config, const InsertionConfig& insertion) {
   return map_config.rules.mass_counting == MassCounting::kPerScan &&
-         insertion.free_space_rays == FreeSpaceRays::kOnePerEndVoxel &&
+         insertion.free_space_rays != FreeSpaceRays::kEveryReading &&
          insertion.model_negative_space;
 }
 /// Splits a scan's readings among `chunks` threads (see scan_update.cpp), reading them on
@@ -630,6 +712,8 @@ struct ScanUpdate::Impl {
   /// all once grouped (each thread groups a part of the readings into one), before the chunks
   /// walk them.
   std::vector<detail::EndVoxelRays> end_voxels;
+  /// One per chunk: its end voxels' rays by end column (FreeSpaceRays::kOnePathPerEndColumn).
+  std::vector<detail::EndColumnRuns> end_columns;
   /// With several threads: the scratch of each reading of the scan (splitReadingsBySector).
   detail::ReadingSplit split;
   std::unique_ptr<detail::ThreadPool> pool;

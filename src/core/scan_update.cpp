@@ -227,6 +227,25 @@ constexpr double kShallowRayMaxHeight = 1 << 20;
 /// height, so every cell it crosses gets this one free volume.
 Volume levelRayVolume(float height) { return makeVolume(height, height); }
 
+/// The last cell of a reading's walk, entered at height `z_enter`, ending at `end_z` (grid
+/// units): a reading without a return frees its crossing (eq. 4); an obstacle adds its positive
+/// volume (eq. 5) only if `add_hit`, and frees the crossing up to it (Fig. 3, left).
+template <class Writer, class FreeVolume>
+[[gnu::always_inline]] inline void addLastCrossing(double z_enter, double end_z, bool obstacle,
+                                                   bool add_hit, Writer& scratch,
+                                                   const FreeVolume& free_volume) {
+  if (!obstacle) {
+    scratch.addFree(free_volume(z_enter, end_z));
+    return;
+  }
+  const Volume positive = hitVolume(static_cast<float>(end_z));
+  if (add_hit) scratch.addHit(positive);
+  if (std::fabs(z_enter - end_z) > 1.0) {  // pad up to the obstacle
+    scratch.addFree(
+        makeVolume(static_cast<float>(z_enter), z_enter < end_z ? positive.bottom : positive.top));
+  }
+}
+
 /// Sec. III-B.2: the volumes of one reading from `start` to `end` (grid units), into `scratch`,
 /// each cell's free volume from `free_volume(z_enter, z_exit)`; an obstacle's own positive
 /// volume only if `add_hit` (FreeSpaceRays::kOnePerEndVoxel adds each hit's apart).
@@ -239,20 +258,47 @@ template <class Writer, class FreeVolume>
                                                const Eigen::Vector3d& end, bool obstacle,
                                                bool add_hit, Writer& scratch,
                                                const FreeVolume& free_volume) {
-  const auto end_z = static_cast<float>(end.z());
   auto visit = [&](double z_enter, double z_exit, bool is_last) __attribute__((always_inline)) {
-    if (!is_last || !obstacle) {  // eqs. (3) and (4)
+    if (!is_last) {  // eq. (3)
       scratch.addFree(free_volume(z_enter, z_exit));
       return;
     }
-    const Volume positive = hitVolume(end_z);
-    if (add_hit) scratch.addHit(positive);
-    if (std::fabs(z_enter - end.z()) > 1.0) {  // Fig. 3, left: pad up to the obstacle
-      scratch.addFree(makeVolume(static_cast<float>(z_enter),
-                                 z_enter < end.z() ? positive.bottom : positive.top));
-    }
+    addLastCrossing(z_enter, end.z(), obstacle, add_hit, scratch, free_volume);
   };
   walkRayWith(scratch, start.x(), start.y(), start.z(), end.x(), end.y(), end.z(), visit);
+}
+
+/// The rays of a run of one end column (FreeSpaceRays::kOnePathPerEndColumn): ends[0, count)
+/// (grid units) sorted by height, walked from `start` along the xy-path of ends[path]. Each
+/// cell before the column gets the hull of the lowest and the highest ray's crossings (eq. 6
+/// each), which holds those of the rays between them (kColumnRunHeightGap); in the column, each
+/// ray its own last crossing (addLastCrossing).
+template <class Writer>
+void walkColumnRun(const Eigen::Vector3d& start, const Eigen::Vector3d* ends, std::size_t count,
+                   std::size_t path, bool obstacle, Writer scratch) {
+  const double lowest_rise = ends[0].z() - start.z();
+  const double highest_rise = ends[count - 1].z() - start.z();
+  auto free_volume = [](double z_enter, double z_exit) {
+    return makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit));
+  };
+  // The path's heights go from 0 to 1: walkRayWith gives each crossing's parameters t, from
+  // which a ray's heights are start.z() + t * rise, as its own walk computes them.
+  auto visit = [&](double t_enter, double t_exit, bool is_last) __attribute__((always_inline)) {
+    if (!is_last) {
+      const Volume lowest =
+          free_volume(start.z() + t_enter * lowest_rise, start.z() + t_exit * lowest_rise);
+      const Volume highest =
+          free_volume(start.z() + t_enter * highest_rise, start.z() + t_exit * highest_rise);
+      scratch.addFree(volumeOfMinimumHeight(std::min(lowest.bottom, highest.bottom),
+                                            std::max(lowest.top, highest.top)));
+      return;
+    }
+    for (std::size_t k = 0; k < count; ++k) {
+      addLastCrossing(start.z() + t_enter * (ends[k].z() - start.z()), ends[k].z(), obstacle, false,
+                      scratch, free_volume);
+    }
+  };
+  walkRayWith(scratch, start.x(), start.y(), 0.0, ends[path].x(), ends[path].y(), 1.0, visit);
 }
 
 /// A hit's positive volume alone (eq. 5), in the cell a walk to `end` (grid units) would end in
@@ -341,7 +387,7 @@ CellRange tilesOf(const CellRange& cells) {
 /// the others'.
 template <class Writer, class Mine>
 void rasterizeEndVoxels(const EndVoxelRays& voxels, const Mine& mine, const Eigen::Vector3d& start,
-                        Writer& writer, InsertionResult& result) {
+                        EndColumnRuns* columns, Writer& writer, InsertionResult& result) {
   const std::vector<VoxelReadings>& all = voxels.voxels();
   const auto began = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < all.size(); ++k) {
@@ -350,9 +396,22 @@ void rasterizeEndVoxels(const EndVoxelRays& voxels, const Mine& mine, const Eige
     hit_writer.moveTo(all[k].cell);
     hit_writer.addHit(EndVoxelRays::hitsOf(all[k]));
   }
+  if (columns != nullptr) columns->gather(all, mine);
   auto walk = [&](bool obstacle) {
     for (std::size_t k = 0; k < all.size(); ++k) {
       if (all[k].obstacle != obstacle || !mine(k)) continue;
+      if (columns != nullptr && all[k].count >= kReadingsForOneRay) {
+        columns->walkRunFrom(k,
+                             [&](const Eigen::Vector3d* ends, std::size_t count, std::size_t path) {
+                               if (count == 1) {
+                                 addReading(start, ends[0], obstacle, false, writer);
+                               } else {
+                                 walkColumnRun(start, ends, count, path, obstacle, writer);
+                               }
+                               ++result.rays_walked;
+                             });
+        continue;
+      }
       EndVoxelRays::forEachRayOf(all[k], [&](const Eigen::Vector3d& end) {
         addReading(start, end, obstacle, false, writer);
         ++result.rays_walked;
@@ -596,6 +655,8 @@ void ScanUpdate::walkEndVoxels(const Eigen::Vector3d& origin, const CellRange& c
   const CellRange tiles = detail::tilesOf(cells);
   const Volume level_volume = detail::levelRayVolume(static_cast<float>(start.z()));
   const float join_gap = detail::joinGapOf(map_config.rules);
+  const bool by_column = impl.insertion.free_space_rays == FreeSpaceRays::kOnePathPerEndColumn;
+  if (impl.end_columns.size() < num_threads) impl.end_columns.resize(num_threads);
   std::vector<InsertionResult> results(num_threads);
   // The end voxels of chunk k (split.chunk_of_reading) go to scratch k.
   auto rasterize = [&](std::size_t, std::size_t chunk) {
@@ -604,12 +665,13 @@ void ScanUpdate::walkEndVoxels(const Eigen::Vector3d& origin, const CellRange& c
       return num_threads == 1 || impl.split.chunk_of_reading[k] == chunk;
     };
     scratch.begin(join_gap, false, tiles, level ? &level_volume : nullptr);
+    detail::EndColumnRuns* columns = by_column ? &impl.end_columns[chunk] : nullptr;
     if (level) {
       detail::ScanScratch::Writer<false, true> writer(scratch);
-      detail::rasterizeEndVoxels(impl.end_voxels[0], mine, start, writer, results[chunk]);
+      detail::rasterizeEndVoxels(impl.end_voxels[0], mine, start, columns, writer, results[chunk]);
     } else {
       detail::ScanScratch::Writer<false> writer(scratch);
-      detail::rasterizeEndVoxels(impl.end_voxels[0], mine, start, writer, results[chunk]);
+      detail::rasterizeEndVoxels(impl.end_voxels[0], mine, start, columns, writer, results[chunk]);
     }
   };
   if (detail::ThreadPool* pool = impl.threads(num_threads)) {

@@ -113,7 +113,8 @@ void bindConfigs(py::module_& module) {
   py::enum_<mvog::FreeSpaceRays>(module, "FreeSpaceRays",
                                  "Which rays of a scan are walked for free space.")
       .value("EVERY_READING", mvog::FreeSpaceRays::kEveryReading)
-      .value("ONE_PER_END_VOXEL", mvog::FreeSpaceRays::kOnePerEndVoxel);
+      .value("ONE_PER_END_VOXEL", mvog::FreeSpaceRays::kOnePerEndVoxel)
+      .value("ONE_PATH_PER_END_COLUMN", mvog::FreeSpaceRays::kOnePathPerEndColumn);
   py::enum_<mvog::OccupancyState>(module, "OccupancyState",
                                   "A point's or a cell's state; arrays of states hold these "
                                   "values as uint8 (0 unknown, 1 free, 2 occupied).")

@@ -181,9 +181,11 @@ void InsertionWorkerConfig::validate() const {
 
 mvog::FreeSpaceRays freeSpaceRaysFromName(const std::string& name) {
   if (name == "every_reading") return mvog::FreeSpaceRays::kEveryReading;
-  require(name == "one_per_end_voxel", "free_space_rays",
-          "must be 'one_per_end_voxel' or 'every_reading', not '" + name + "'");
-  return mvog::FreeSpaceRays::kOnePerEndVoxel;
+  if (name == "one_per_end_voxel") return mvog::FreeSpaceRays::kOnePerEndVoxel;
+  require(name == "one_path_per_end_column", "free_space_rays",
+          "must be 'one_path_per_end_column', 'one_per_end_voxel' or 'every_reading', not '" +
+              name + "'");
+  return mvog::FreeSpaceRays::kOnePathPerEndColumn;
 }
 
 void DecayConfig::validate() const {
@@ -275,7 +277,7 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   read(nh, "insert_out_of_range", insertion.insert_out_of_range);
   read(nh, "model_negative_space", insertion.model_negative_space);
   read(nh, "insertion_threads", insertion.insertion_threads);
-  std::string free_space_rays = "one_per_end_voxel";
+  std::string free_space_rays = "one_path_per_end_column";
   read(nh, "free_space_rays", free_space_rays);
   insertion.free_space_rays = freeSpaceRaysFromName(free_space_rays);
   read(nh, "evidence_limit", insertion.evidence_limit);

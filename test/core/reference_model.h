@@ -40,8 +40,17 @@ class ReferenceModel {
     // obstacle) are walked each while fewer than 4, else only the one ending nearest the voxel's
     // centre (ties: the lowest end in x, then y, then z).
     const bool one_ray_per_voxel = config_.rules.mass_counting == MassCounting::kPerScan &&
-                                   insertion.free_space_rays == FreeSpaceRays::kOnePerEndVoxel &&
+                                   insertion.free_space_rays != FreeSpaceRays::kEveryReading &&
                                    insertion.model_negative_space;
+    // FreeSpaceRays::kOnePathPerEndColumn: the rays of the voxels of 4 or more readings, by end
+    // column and kind, sorted by height and cut where two neighbours' heights part by more than
+    // 2 cells, each run walked along the path of its ray ending nearest the column's axis: a
+    // cell before the column gets the hull of the lowest and highest rays' eq. 6 volumes at the
+    // path's entry and exit parameters, the column each ray's last crossing.
+    const bool one_path_per_column =
+        one_ray_per_voxel && insertion.free_space_rays == FreeSpaceRays::kOnePathPerEndColumn;
+    std::map<std::tuple<std::int32_t, std::int32_t, bool>, std::vector<Eigen::Vector3d>>
+        column_ends;
     using Voxel = std::tuple<std::int32_t, std::int32_t, std::int32_t, bool>;
     std::map<Voxel, std::vector<Eigen::Vector3d>> voxel_ends;
     auto walk = [&](const Eigen::Vector3d& end, bool obstacle, bool with_hit) {
@@ -109,7 +118,68 @@ class ReferenceModel {
                    ? da < db
                    : std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
       };
-      walk(*std::min_element(ends.begin(), ends.end(), nearer), obstacle, false);
+      const Eigen::Vector3d& nearest = *std::min_element(ends.begin(), ends.end(), nearer);
+      if (one_path_per_column) {
+        column_ends[{std::get<0>(voxel), std::get<1>(voxel), obstacle}].push_back(nearest);
+        continue;
+      }
+      walk(nearest, obstacle, false);
+    }
+    auto walk_run = [&](const std::vector<Eigen::Vector3d>& run, bool obstacle) {
+      if (run.size() == 1) {
+        walk(run[0], obstacle, false);
+        return;
+      }
+      const Eigen::Vector2d axis(std::floor(run[0].x()) + 0.5, std::floor(run[0].y()) + 0.5);
+      const auto nearer_axis = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+        const double da = (a.head<2>() - axis).squaredNorm();
+        const double db = (b.head<2>() - axis).squaredNorm();
+        return da != db
+                   ? da < db
+                   : std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+      };
+      const Eigen::Vector3d path = *std::min_element(run.begin(), run.end(), nearer_axis);
+      auto height = [&](double t, double end_z) { return start.z() + t * (end_z - start.z()); };
+      walkRay(
+          start.x(), start.y(), 0.0, path.x(), path.y(), 1.0,
+          [&](const CellIndex& c, double t_enter, double t_exit, bool is_last) {
+            auto& [free, hits] = seen[{c.x, c.y}];
+            if (!is_last) {
+              const Volume low = makeVolume(static_cast<float>(height(t_enter, run.front().z())),
+                                            static_cast<float>(height(t_exit, run.front().z())));
+              const Volume high = makeVolume(static_cast<float>(height(t_enter, run.back().z())),
+                                             static_cast<float>(height(t_exit, run.back().z())));
+              free.push_back(volumeOfMinimumHeight(std::min(low.bottom, high.bottom),
+                                                   std::max(low.top, high.top)));
+              return;
+            }
+            for (const Eigen::Vector3d& end : run) {
+              const double z_enter = height(t_enter, end.z());
+              if (!obstacle) {
+                free.push_back(
+                    makeVolume(static_cast<float>(z_enter), static_cast<float>(end.z())));
+                continue;
+              }
+              const auto end_z = static_cast<float>(end.z());
+              if (std::fabs(z_enter - end.z()) > 1.0) {
+                free.push_back(makeVolume(static_cast<float>(z_enter),
+                                          z_enter < end.z() ? end_z - 0.5f : end_z + 0.5f));
+              }
+            }
+          });
+    };
+    for (auto& [column, ends] : column_ends) {
+      std::sort(ends.begin(), ends.end(),
+                [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.z() < b.z(); });
+      std::vector<Eigen::Vector3d> run;
+      for (const Eigen::Vector3d& end : ends) {
+        if (!run.empty() && end.z() - run.back().z() > 2.0) {
+          walk_run(run, std::get<2>(column));
+          run.clear();
+        }
+        run.push_back(end);
+      }
+      walk_run(run, std::get<2>(column));
     }
 
     const ModelRules& rules = config_.rules;

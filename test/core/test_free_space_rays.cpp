@@ -1,8 +1,10 @@
-// One ray per end voxel (FreeSpaceRays::kOnePerEndVoxel, the default with per-scan masses): which
-// rays a scan walks (InsertionResult::rays_walked), that every hit keeps its own volume, that one
-// scan frees a subset of what every reading's walk frees, that the map still depends neither on
-// the readings' order nor on the thread count, and how closely it agrees with every reading's
-// walk on a depth camera's image and on the shared recordings ($MVOG_DATA_DIR).
+// One ray per end voxel (FreeSpaceRays::kOnePerEndVoxel) and one path per end column
+// (kOnePathPerEndColumn, the default with per-scan masses): which rays a scan walks
+// (InsertionResult::rays_walked), that every hit keeps its own volume, that one scan's rays per
+// end voxel free a subset of what every reading's walk frees, that rays on one path free what
+// each walked alone frees, that the map still depends neither on the readings' order nor on the
+// thread count, and how closely it agrees with every reading's walk on a depth camera's image and
+// on the shared recordings ($MVOG_DATA_DIR).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -41,6 +43,11 @@ MapConfig mapConfig(double resolution = kResolution, const ModelRules& rules = {
 
 InsertionConfig everyReading(InsertionConfig config = {}) {
   config.free_space_rays = FreeSpaceRays::kEveryReading;
+  return config;
+}
+
+InsertionConfig onePerEndVoxel(InsertionConfig config = {}) {
+  config.free_space_rays = FreeSpaceRays::kOnePerEndVoxel;
   return config;
 }
 
@@ -152,15 +159,15 @@ struct AgreementByKind {
   }
 };
 
-/// The agreement of `one_ray` with `every_reading` at `points`, printed under `name` and recorded
-/// as the test's properties.
+/// The agreement of `one_ray` (the default's rays) with `every_reading` at `points`, printed under
+/// `name` and recorded as the test's properties.
 AgreementByKind compareWithEveryReading(const std::string& name, const ComparedPoints& points,
                                         const Map& one_ray, const Map& every_reading) {
   const AgreementByKind agreement{agreementAt(points.ends, one_ray, every_reading),
                                   agreementAt(points.along_rays, one_ray, every_reading),
                                   agreementAt(points.near_ends, one_ray, every_reading)};
   std::cout << "[ agreement ] " << name
-            << ": one ray per end voxel vs every reading, same state at "
+            << ": the default's rays (one path per end column) vs every reading, same state at "
             << agreement.ends.percent() << " % of " << agreement.ends.points << " ends, "
             << agreement.along_rays.percent() << " % of " << agreement.along_rays.points
             << " points along the rays, " << agreement.near_ends.percent() << " % of "
@@ -176,8 +183,8 @@ AgreementByKind compareWithEveryReading(const std::string& name, const ComparedP
 
 // ---- The option -------------------------------------------------------------------------------
 
-TEST(FreeSpaceRays, TheDefaultIsOneRayPerEndVoxel) {
-  EXPECT_EQ(InsertionConfig{}.free_space_rays, FreeSpaceRays::kOnePerEndVoxel);
+TEST(FreeSpaceRays, TheDefaultIsOnePathPerEndColumn) {
+  EXPECT_EQ(InsertionConfig{}.free_space_rays, FreeSpaceRays::kOnePathPerEndColumn);
 }
 
 TEST(FreeSpaceRays, ValidateRefusesAValueOutsideTheEnumNamingTheField) {
@@ -259,6 +266,83 @@ TEST(FreeSpaceRays, WithoutNegativeSpaceNoRayIsWalkedAndTheHitsAreKept) {
   });
 }
 
+// ---- One path per end column ------------------------------------------------------------------
+
+/// A scan from kSensor with `readings` hits in each of the voxels of kVoxel's column whose
+/// height cells are `levels` (above kVoxel's), all at the xy of `at` (a point of that column).
+Scan hitsInColumn(const std::vector<int>& levels, std::size_t readings, const Eigen::Vector2d& at) {
+  Scan scan;
+  scan.origin = kSensor;
+  for (int level : levels) {
+    for (std::size_t k = 0; k < readings; ++k) {
+      const double z = kVoxel.z() + kResolution * (level + 0.2 + 0.6 * k / readings);
+      scan.hits.push_back(Eigen::Vector3d(at.x(), at.y(), z).cast<float>());
+    }
+  }
+  return scan;
+}
+
+/// kVoxel's column's centre.
+const Eigen::Vector2d kColumnCentre = kVoxel.head<2>() + Eigen::Vector2d::Constant(0.05);
+
+TEST(FreeSpaceRays, AColumnsDenseVoxelsWithinTwoCellsOfEachOtherWalkOnePath) {
+  // Voxels of 10 readings at height cells 0, 1 and 2 of one column: one path (one ray per end
+  // voxel walks 3); a voxel 6 cells above the others starts a run of its own.
+  const Scan stacked = hitsInColumn({0, 1, 2}, 10, kColumnCentre);
+  EXPECT_EQ(insertIntoNewMap(stacked).rays_walked, 1u);
+  EXPECT_EQ(insertIntoNewMap(stacked, onePerEndVoxel()).rays_walked, 3u);
+  EXPECT_EQ(insertIntoNewMap(hitsInColumn({0, 1, 2, 8}, 10, kColumnCentre)).rays_walked, 2u);
+}
+
+TEST(FreeSpaceRays, ASparseVoxelsReadingsKeepTheirOwnRays) {
+  // Voxels of 3 readings (kReadingsForOneRay) walk each, whatever their column holds.
+  EXPECT_EQ(insertIntoNewMap(hitsInColumn({0, 1, 2}, 3, kColumnCentre)).rays_walked, 9u);
+  Scan mixed = hitsInColumn({0, 1}, 10, kColumnCentre);
+  const Scan sparse = hitsInColumn({2}, 2, kColumnCentre);
+  mixed.hits.insert(mixed.hits.end(), sparse.hits.begin(), sparse.hits.end());
+  EXPECT_EQ(insertIntoNewMap(mixed).rays_walked, 3u);
+}
+
+TEST(FreeSpaceRays, RaysOnOnePathFreeTheSameAsEachWalkedAlone) {
+  // Where a column's rays share their xy end, their paths are one: the run's walk (the hull of
+  // its lowest and highest rays in each cell, each ray's own last crossing) must free what each
+  // voxel's ray walked alone frees, which the scan's joins make one interval per cell. Columns
+  // near and far, below and above the sensor (rays falling, rising, and crossing its height),
+  // steep and shallow, hits and readings without a return, under the default rules and the
+  // rules that change how a scan's free space is shaped.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> coordinate(-3.0, 3.0);
+  std::uniform_int_distribution<int> level(-30, 30);
+  Scan scan;
+  scan.origin = kSensor;
+  for (int column = 0; column < 60; ++column) {
+    const Eigen::Vector2d at(coordinate(rng), coordinate(rng));
+    const int lowest = level(rng);
+    std::vector<int> levels;
+    for (int k = 0; k < 1 + column % 6; ++k) levels.push_back(lowest + k);
+    Scan readings = hitsInColumn(levels, 5, at);
+    std::vector<Eigen::Vector3f>& into = column % 4 == 0 ? scan.out_of_range : scan.hits;
+    into.insert(into.end(), readings.hits.begin(), readings.hits.end());
+  }
+  ModelRules whole;  // the readings without a return free their whole length
+  whole.out_of_range_free_length = test::kInf;
+  ModelRules without_clipping = whole;
+  without_clipping.clip_free_space_at_hits = false;
+  ModelRules without_splitting = whole;
+  without_splitting.split_free_space_at_obstacles = false;
+  for (const ModelRules& rules : {whole, without_clipping, without_splitting}) {
+    SCOPED_TRACE("clip " + std::to_string(rules.clip_free_space_at_hits) + ", split " +
+                 std::to_string(rules.split_free_space_at_obstacles));
+    Map one_path(mapConfig(kResolution, rules));
+    Map one_ray(mapConfig(kResolution, rules));
+    const InsertionResult paths = one_path.insertScan(scan);
+    const InsertionResult rays = one_ray.insertScan(scan, onePerEndVoxel());
+    EXPECT_EQ(paths.rays_walked, 60u);
+    EXPECT_EQ(rays.rays_walked, 210u);
+    EXPECT_TRUE(test::sameVolumes(allVolumes(one_path), allVolumes(one_ray)));
+  }
+}
+
 // ---- What the map holds -----------------------------------------------------------------------
 
 TEST(FreeSpaceRays, EveryHitKeepsItsOwnVolume) {
@@ -308,13 +392,13 @@ std::vector<Eigen::Vector3d> pointsAround(const Scan& scan, std::mt19937& rng) {
   return points;
 }
 
-TEST(FreeSpaceRays, OneScanOnAnEmptyMapFreesASubsetOfWhatEveryReadingFrees) {
-  // The walked rays are some of the readings' rays, so the scan's new free space in each column
-  // is a subset of every reading's, and the hits are the same. On an empty map a point is
-  // occupied iff it lies in a positive volume, so at any point: occupied in one map iff in the
-  // other, free with one ray per end voxel implies free with every reading, unknown with every
-  // reading implies unknown with one ray. Under the default rules and with each of the two rules
-  // that shape a scan's free space off.
+TEST(FreeSpaceRays, OneRayPerEndVoxelFreesASubsetOfWhatEveryReadingFreesInOneScan) {
+  // With kOnePerEndVoxel the walked rays are some of the readings' rays, so the scan's new free
+  // space in each column is a subset of every reading's, and the hits are the same. On an empty map
+  // a point is occupied iff it lies in a positive volume, so at any point: occupied in one map iff
+  // in the other, free with one ray per end voxel implies free with every reading, unknown with
+  // every reading implies unknown with one ray. Under the default rules and with each of the two
+  // rules that shape a scan's free space off.
   ModelRules without_clipping;
   without_clipping.clip_free_space_at_hits = false;
   ModelRules without_splitting;
@@ -327,7 +411,7 @@ TEST(FreeSpaceRays, OneScanOnAnEmptyMapFreesASubsetOfWhatEveryReadingFrees) {
       const Scan scan = denseScan(rng);
       Map one_ray(mapConfig(0.2, rules));
       Map every_reading(mapConfig(0.2, rules));
-      const InsertionResult result = one_ray.insertScan(scan);
+      const InsertionResult result = one_ray.insertScan(scan, onePerEndVoxel());
       every_reading.insertScan(scan, everyReading());
       EXPECT_LT(result.rays_walked, result.inserted() / 5);
       std::size_t free_with_every_reading_only = 0;
@@ -380,26 +464,30 @@ TEST(FreeSpaceRays, TheMapDependsNeitherOnTheReadingsOrderNorOnTheThreads) {
   // Threads share a scan's readings by direction; the voxels of a scan all around its origin lie
   // across every boundary between their sectors. Shuffled readings, and 1 to 4 threads: the
   // same volumes bit for bit, and the same rays walked; also with the hits beyond 2.6 m truncated
-  // to max_range (their voxels then lie on a sphere, free space only).
+  // to max_range (their voxels then lie on a sphere, free space only). One path per end column
+  // (the default) and one ray per end voxel.
   const Scan scan = surroundingScan();
   const Scan shuffled = shuffledReadings(scan);
-  for (const double max_range : {test::kInf, 2.6}) {
-    SCOPED_TRACE("max_range " + std::to_string(max_range));
-    InsertionConfig one_thread;
-    one_thread.max_range = max_range;
-    Map reference(mapConfig());
-    const InsertionResult walked = reference.insertScan(scan, one_thread);
-    EXPECT_LT(walked.rays_walked, walked.inserted() / 5);
-    EXPECT_EQ(walked.truncated_to_max_range > 0, max_range < test::kInf);
-    for (int threads = 1; threads <= 4; ++threads) {
-      for (const Scan* readings : {&scan, &shuffled}) {
-        SCOPED_TRACE(std::to_string(threads) + " threads" +
-                     (readings == &shuffled ? ", shuffled" : ""));
-        InsertionConfig insertion = one_thread;
-        insertion.insertion_threads = threads;
-        Map map(mapConfig());
-        EXPECT_EQ(map.insertScan(*readings, insertion).rays_walked, walked.rays_walked);
-        EXPECT_TRUE(test::sameVolumes(allVolumes(map), allVolumes(reference)));
+  for (const InsertionConfig& rays : {InsertionConfig{}, onePerEndVoxel()}) {
+    for (const double max_range : {test::kInf, 2.6}) {
+      SCOPED_TRACE("max_range " + std::to_string(max_range) + ", free_space_rays " +
+                   std::to_string(static_cast<int>(rays.free_space_rays)));
+      InsertionConfig one_thread = rays;
+      one_thread.max_range = max_range;
+      Map reference(mapConfig());
+      const InsertionResult walked = reference.insertScan(scan, one_thread);
+      EXPECT_LT(walked.rays_walked, walked.inserted() / 5);
+      EXPECT_EQ(walked.truncated_to_max_range > 0, max_range < test::kInf);
+      for (int threads = 1; threads <= 4; ++threads) {
+        for (const Scan* readings : {&scan, &shuffled}) {
+          SCOPED_TRACE(std::to_string(threads) + " threads" +
+                       (readings == &shuffled ? ", shuffled" : ""));
+          InsertionConfig insertion = one_thread;
+          insertion.insertion_threads = threads;
+          Map map(mapConfig());
+          EXPECT_EQ(map.insertScan(*readings, insertion).rays_walked, walked.rays_walked);
+          EXPECT_TRUE(test::sameVolumes(allVolumes(map), allVolumes(reference)));
+        }
       }
     }
   }
@@ -509,7 +597,7 @@ struct AgreementBounds {
   double near_ends;
 };
 
-/// Maps `file` ($MVOG_DATA_DIR) at 0.05 m with one ray per end voxel and with every reading, and
+/// Maps `file` ($MVOG_DATA_DIR) at 0.05 m with the default's rays and with every reading, and
 /// compares them at the points of about 5,000 of its hits.
 void expectAgreementOnRecording(const std::string& file, const AgreementBounds& bounds) {
   const std::string path = mvog_test::dataDirectory() + "/" + file;
@@ -534,8 +622,8 @@ void expectAgreementOnRecording(const std::string& file, const AgreementBounds& 
 // the rays, within 2 cells of the ends), less 0.3 points.
 
 TEST(FreeSpaceRays, AgreesWithEveryReadingOnKurt3d) {
-  // Measured: 100 %, 99.996 %, 99.896 %.
-  expectAgreementOnRecording("kurt3d_3scans.graph", {99.7, 99.69, 99.59});
+  // Measured: 100 %, 99.996 %, 99.852 %.
+  expectAgreementOnRecording("kurt3d_3scans.graph", {99.7, 99.69, 99.55});
 }
 
 TEST(FreeSpaceRays, AgreesWithEveryReadingOnTumPioneer) {
@@ -544,8 +632,8 @@ TEST(FreeSpaceRays, AgreesWithEveryReadingOnTumPioneer) {
 }
 
 TEST(FreeSpaceRays, AgreesWithEveryReadingOnTheSphericalScan) {
-  // Synthetic: every point 4.01 m from the sensor. Measured: 100 %, 99.977 %, 99.275 %.
-  expectAgreementOnRecording("spherical_scan.graph", {99.7, 99.67, 98.97});
+  // Synthetic: every point 4.01 m from the sensor. Measured: 100 %, 99.977 %, 99.265 %.
+  expectAgreementOnRecording("spherical_scan.graph", {99.7, 99.67, 98.96});
 }
 
 }  // namespace

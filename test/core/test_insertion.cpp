@@ -586,12 +586,13 @@ std::string describe(const ModelRules& rules) {
   return text.str();
 }
 
-/// Insertions walking every reading's ray and one ray per end voxel (FreeSpaceRays), each with
-/// unbounded evidence and with InsertionConfig::evidence_limit 3 (reached within the tests'
-/// scans).
+/// Insertions walking every reading's ray, one ray per end voxel and one path per end column
+/// (FreeSpaceRays), each with unbounded evidence and with InsertionConfig::evidence_limit 3
+/// (reached within the tests' scans).
 std::vector<InsertionConfig> everyRayChoice() {
   std::vector<InsertionConfig> choices;
-  for (FreeSpaceRays rays : {FreeSpaceRays::kEveryReading, FreeSpaceRays::kOnePerEndVoxel}) {
+  for (FreeSpaceRays rays : {FreeSpaceRays::kEveryReading, FreeSpaceRays::kOnePerEndVoxel,
+                             FreeSpaceRays::kOnePathPerEndColumn}) {
     for (double evidence_limit : {std::numeric_limits<double>::infinity(), 3.0}) {
       InsertionConfig insertion;
       insertion.free_space_rays = rays;
@@ -603,9 +604,9 @@ std::vector<InsertionConfig> everyRayChoice() {
 }
 
 std::string describe(const InsertionConfig& insertion) {
-  return std::string(insertion.free_space_rays == FreeSpaceRays::kEveryReading
-                         ? ", every reading's ray"
-                         : ", one ray per end voxel") +
+  const char* rays[] = {", every reading's ray", ", one ray per end voxel",
+                        ", one path per end column"};
+  return std::string(rays[static_cast<int>(insertion.free_space_rays)]) +
          (std::isinf(insertion.evidence_limit) ? "" : ", evidence limit 3");
 }
 

@@ -300,8 +300,10 @@ TEST(MapperConfig, RefusesForgettingWithoutDecayAndBadWindows) {
   EXPECT_EQ(refusal(config), "");
 }
 
-TEST(MapperConfig, FreeSpaceRaysDefaultsToOnePerEndVoxelAndReadsBothNames) {
-  EXPECT_EQ(validConfig().insertion.free_space_rays, mvog::FreeSpaceRays::kOnePerEndVoxel);
+TEST(MapperConfig, FreeSpaceRaysDefaultsToOnePathPerEndColumnAndReadsTheThreeNames) {
+  EXPECT_EQ(validConfig().insertion.free_space_rays, mvog::FreeSpaceRays::kOnePathPerEndColumn);
+  EXPECT_EQ(freeSpaceRaysFromName("one_path_per_end_column"),
+            mvog::FreeSpaceRays::kOnePathPerEndColumn);
   EXPECT_EQ(freeSpaceRaysFromName("one_per_end_voxel"), mvog::FreeSpaceRays::kOnePerEndVoxel);
   EXPECT_EQ(freeSpaceRaysFromName("every_reading"), mvog::FreeSpaceRays::kEveryReading);
   MapperConfig config = validConfig();
@@ -310,8 +312,9 @@ TEST(MapperConfig, FreeSpaceRaysDefaultsToOnePerEndVoxelAndReadsBothNames) {
 }
 
 TEST(MapperConfig, RefusesAnUnknownFreeSpaceRaysNamingIt) {
-  // mvog_bench's spelling, another case, empty: only the two names are read.
-  for (const char* name : {"every-reading", "Every_Reading", "one_per_voxel", ""}) {
+  // mvog_bench's spelling, another case, empty: only the three names are read.
+  for (const char* name :
+       {"every-reading", "one-path-per-end-column", "Every_Reading", "one_per_voxel", ""}) {
     std::string message;
     try {
       freeSpaceRaysFromName(name);

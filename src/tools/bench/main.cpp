@@ -5,7 +5,7 @@
 //              [--fixed-frame FRAME]
 //              [--model default|paper] [--clip-free-space-at-hits on|off]
 //              [--mass-counting per-scan|per-reading] [--split-free-space-at-obstacles on|off]
-//              [--free-space-rays one-per-end-voxel|every-reading]
+//              [--free-space-rays one-path-per-end-column|one-per-end-voxel|every-reading]
 //              [--octomap-clamping on|off] [--evidence-limit E|inf]
 //              [--truth-slice OUT.ppm]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
@@ -67,7 +67,8 @@ constexpr const char* kUsage =
     "                  [--mass-counting per-scan|per-reading]\n"
     "                  [--split-free-space-at-obstacles on|off] [--occupancy-threshold T]\n"
     "                  [--out-of-range-free-length L|inf]\n"
-    "                  [--free-space-rays one-per-end-voxel|every-reading]\n"
+    "                  [--free-space-rays one-path-per-end-column|one-per-end-voxel|\n"
+    "                                     every-reading]\n"
     "                  [--octomap-clamping on|off] [--evidence-limit E|inf]\n"
     "                  [--truth-slice OUT.ppm]\n"
     "  FILE        a ROS bag (LaserScan, PointCloud2 and/or depth Image 16UC1 or 32FC1 with\n"
@@ -96,8 +97,8 @@ constexpr const char* kUsage =
     "              paper's Table I)\n"
     "  --model     MVOG's rules: the defaults, or the paper's exact model; the options after\n"
     "              it change one rule each (mvog::ModelRules, README's decisions table)\n"
-    "  --free-space-rays  MVOG walks one ray per end voxel (the default) or every reading's\n"
-    "              (mvog::FreeSpaceRays)\n"
+    "  --free-space-rays  MVOG walks one path per end column's run of end voxels (the\n"
+    "              default), one ray per end voxel or every reading's (mvog::FreeSpaceRays)\n"
     "  E           MVOG's evidence limit in scans, with per-scan masses\n"
     "              (mvog::InsertionConfig::evidence_limit; default 14)\n"
     "  --octomap-clamping  OctoMap's log-odds clamped at each update (on, its default) or\n"
@@ -189,12 +190,18 @@ Arguments parseArguments(int argc, char** argv) {
       arguments.rules.mass_counting =
           value == "per-scan" ? mvog::MassCounting::kPerScan : mvog::MassCounting::kPerReading;
     } else if (option == "--free-space-rays") {
-      if (value != "one-per-end-voxel" && value != "every-reading") {
-        throw UsageError("--free-space-rays must be one-per-end-voxel or every-reading, got '" +
-                         value + "'");
+      if (value == "one-path-per-end-column") {
+        arguments.free_space_rays = mvog::FreeSpaceRays::kOnePathPerEndColumn;
+      } else if (value == "one-per-end-voxel") {
+        arguments.free_space_rays = mvog::FreeSpaceRays::kOnePerEndVoxel;
+      } else if (value == "every-reading") {
+        arguments.free_space_rays = mvog::FreeSpaceRays::kEveryReading;
+      } else {
+        throw UsageError(
+            "--free-space-rays must be one-path-per-end-column, one-per-end-voxel or "
+            "every-reading, got '" +
+            value + "'");
       }
-      arguments.free_space_rays = value == "every-reading" ? mvog::FreeSpaceRays::kEveryReading
-                                                           : mvog::FreeSpaceRays::kOnePerEndVoxel;
     } else if (option == "--evidence-limit") {
       arguments.evidence_limit =
           value == "inf" ? std::numeric_limits<double>::infinity() : positiveNumber(option, value);
