@@ -868,6 +868,10 @@ TEST(Insertion, LevelAndShallowRaysEqualThePlainReference) {
   std::mt19937 rng(5);
   for (const ModelRules& rules : everyRuleSet()) {
     for (const InsertionConfig& insertion : everyRayChoice()) {
+      // One ray per end voxel walks the rays one path per end column walks unless two voxels of
+      // 4 readings share a column, which these planar scans' 121 beams at random ranges hardly
+      // give: not run twice in the longest test under the sanitizers (the others run all three).
+      if (insertion.free_space_rays == FreeSpaceRays::kOnePerEndVoxel) continue;
       SCOPED_TRACE(describe(rules) + describe(insertion));
       test::MapBesideReference maps(MapConfig{0.05, 60000.0, rules});
       for (const double height : {0.3, 0.025, 0.02500001, -0.0, 1.7e-8, -2.4, 52428.0, -52429.0}) {
