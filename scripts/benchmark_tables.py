@@ -58,7 +58,7 @@ def state_agreement(agreement):
 
 
 def every_reading_row(name, resolution, run):
-    """MVOG's default insertion (one path per end column) against every reading's walk, when the run
+    """MVOG's default insertion (one ray per end voxel) against every reading's walk, when the run
     has both (--backend every-reading): rays, time and memory ratios, and the agreement."""
     results = {b: by_resolution(run["results"], b).get(resolution)
                for b in ("mvog", "mvog_every_reading")}
@@ -210,9 +210,9 @@ def main(out):
             every_reading.append(every_reading_row(file_name(path, "synthetic_"), resolution, run))
     every_reading = [r for r in every_reading if r]
     if every_reading:
-        print("\n### One path per end column against every reading's ray (MVOG, one thread)\n")
+        print("\n### One ray per end voxel against every reading's ray (MVOG, one thread)\n")
         print(table(["file", "res (m)", "readings", "rays walked", "every reading (s)",
-                     "one path per end column (s)", "speed-up", "memory", "same state: ends",
+                     "one per end voxel (s)", "speed-up", "memory", "same state: ends",
                      "along rays", "within 2 cells of the ends"], every_reading))
     print("\n### Memory (MB)\n")
     print(table(["file", "res (m)", "MVOG held", "OctoMap held (pruned)", "MVOG / OctoMap",
