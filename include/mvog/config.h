@@ -124,6 +124,8 @@ enum class FreeSpaceRays : std::uint8_t {
   /// part by less than a cell at the column and less towards the origin; a depth camera's wall
   /// puts tens of voxels in a column, whose walks become one. The readings of voxels of fewer
   /// are walked each, as kOnePerEndVoxel does: a sparse sensor's rays part by up to a cell.
+  /// Not the default: it frees a little less near surfaces on the ground-truth scenes
+  /// (BENCHMARKS.md section 5), for 15 % fewer instructions on a depth camera's frames.
   kOnePathPerEndColumn,
 };
 
@@ -142,7 +144,7 @@ struct InsertionConfig {
   int insertion_threads = 1;
   /// See FreeSpaceRays (the README's decisions table: measured agreement with every reading's
   /// walk in BENCHMARKS.md).
-  FreeSpaceRays free_space_rays = FreeSpaceRays::kOnePathPerEndColumn;
+  FreeSpaceRays free_space_rays = FreeSpaceRays::kOnePerEndVoxel;
   /// Bounded evidence (OctoMap's clamping): after a scan's update of a column, a volume whose
   /// density (eq. 2) and the highest density of the other list's volumes it overlaps sum to more
   /// than this has its mass scaled down so that they sum to it (boundEvidence). A height then

@@ -46,8 +46,8 @@ struct InsertionWorkerConfig : mvog::InsertionConfig {
   void validate() const;
 };
 
-/// ~free_space_rays: `one_path_per_end_column` (FreeSpaceRays::kOnePathPerEndColumn, the
-/// default), `one_per_end_voxel` (kOnePerEndVoxel) or `every_reading` (kEveryReading). Throws
+/// ~free_space_rays: `one_per_end_voxel` (FreeSpaceRays::kOnePerEndVoxel, the default),
+/// `one_path_per_end_column` (kOnePathPerEndColumn) or `every_reading` (kEveryReading). Throws
 /// mvog::ConfigError naming the parameter for any other name.
 mvog::FreeSpaceRays freeSpaceRaysFromName(const std::string& name);
 

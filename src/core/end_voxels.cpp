@@ -120,13 +120,6 @@ void EndColumnRuns::formRuns(std::size_t voxels) {
   run_of_first_voxel_.assign(voxels, kNoRun);
   std::uint32_t first = 0;
   for (const std::uint32_t end : column_rays_) {
-    if (end - first == 1) {  // most columns of most scans: a run of one ray
-      by_column_[first] = sorted_[first].end;
-      run_of_first_voxel_[sorted_[first].voxel] = static_cast<std::uint32_t>(runs_.size());
-      runs_.push_back({first, 1, 0});
-      first = end;
-      continue;
-    }
     std::sort(sorted_.begin() + first, sorted_.begin() + end,
               [](const RayEnd& a, const RayEnd& b) { return a.end.z() < b.end.z(); });
     const CellIndex cell = cellAt(sorted_[first].end.x(), sorted_[first].end.y());

@@ -227,17 +227,17 @@ constexpr double kShallowRayMaxHeight = 1 << 20;
 /// height, so every cell it crosses gets this one free volume.
 Volume levelRayVolume(float height) { return makeVolume(height, height); }
 
-/// The last cell of a reading's walk, entered at height `z_enter`, ending at `end_z` (grid
-/// units): a reading without a return frees its crossing (eq. 4); an obstacle adds its positive
-/// volume (eq. 5) only if `add_hit`, and frees the crossing up to it (Fig. 3, left).
-template <class Writer, class FreeVolume>
-[[gnu::always_inline]] inline void addLastCrossing(double z_enter, double end_z, bool obstacle,
-                                                   bool add_hit, Writer& scratch,
-                                                   const FreeVolume& free_volume) {
-  if (!obstacle) {
-    scratch.addFree(free_volume(z_enter, end_z));
-    return;
-  }
+/// Eq. (6): the free volume of a crossing from height `z_enter` to `z_exit` (grid units).
+[[gnu::always_inline]] inline Volume crossingVolume(double z_enter, double z_exit) {
+  return makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit));
+}
+
+/// The last cell of an obstacle reading's walk, entered at height `z_enter`, ending at `end_z`
+/// (grid units): its positive volume (eq. 5) only if `add_hit`, and the free space up to it
+/// (Fig. 3, left).
+template <class Writer>
+[[gnu::always_inline]] inline void addObstacleEnd(double z_enter, double end_z, bool add_hit,
+                                                  Writer& scratch) {
   const Volume positive = hitVolume(static_cast<float>(end_z));
   if (add_hit) scratch.addHit(positive);
   if (std::fabs(z_enter - end_z) > 1.0) {  // pad up to the obstacle
@@ -259,11 +259,11 @@ template <class Writer, class FreeVolume>
                                                bool add_hit, Writer& scratch,
                                                const FreeVolume& free_volume) {
   auto visit = [&](double z_enter, double z_exit, bool is_last) __attribute__((always_inline)) {
-    if (!is_last) {  // eq. (3)
+    if (!is_last || !obstacle) {  // eqs. (3) and (4)
       scratch.addFree(free_volume(z_enter, z_exit));
       return;
     }
-    addLastCrossing(z_enter, end.z(), obstacle, add_hit, scratch, free_volume);
+    addObstacleEnd(z_enter, end.z(), add_hit, scratch);
   };
   walkRayWith(scratch, start.x(), start.y(), start.z(), end.x(), end.y(), end.z(), visit);
 }
@@ -272,30 +272,31 @@ template <class Writer, class FreeVolume>
 /// (grid units) sorted by height, walked from `start` along the xy-path of ends[path]. Each
 /// cell before the column gets the hull of the lowest and the highest ray's crossings (eq. 6
 /// each), which holds those of the rays between them (kColumnRunHeightGap); in the column, each
-/// ray its own last crossing (addLastCrossing).
+/// ray its own last crossing (eq. 4, or addObstacleEnd).
 template <class Writer>
 void walkColumnRun(const Eigen::Vector3d& start, const Eigen::Vector3d* ends, std::size_t count,
                    std::size_t path, bool obstacle, Writer scratch) {
   const double lowest_rise = ends[0].z() - start.z();
   const double highest_rise = ends[count - 1].z() - start.z();
-  auto free_volume = [](double z_enter, double z_exit) {
-    return makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit));
-  };
   // The path's heights go from 0 to 1: walkRayWith gives each crossing's parameters t, from
   // which a ray's heights are start.z() + t * rise, as its own walk computes them.
   auto visit = [&](double t_enter, double t_exit, bool is_last) __attribute__((always_inline)) {
     if (!is_last) {
       const Volume lowest =
-          free_volume(start.z() + t_enter * lowest_rise, start.z() + t_exit * lowest_rise);
+          crossingVolume(start.z() + t_enter * lowest_rise, start.z() + t_exit * lowest_rise);
       const Volume highest =
-          free_volume(start.z() + t_enter * highest_rise, start.z() + t_exit * highest_rise);
+          crossingVolume(start.z() + t_enter * highest_rise, start.z() + t_exit * highest_rise);
       scratch.addFree(volumeOfMinimumHeight(std::min(lowest.bottom, highest.bottom),
                                             std::max(lowest.top, highest.top)));
       return;
     }
     for (std::size_t k = 0; k < count; ++k) {
-      addLastCrossing(start.z() + t_enter * (ends[k].z() - start.z()), ends[k].z(), obstacle, false,
-                      scratch, free_volume);
+      const double z_enter = start.z() + t_enter * (ends[k].z() - start.z());
+      if (obstacle) {
+        addObstacleEnd(z_enter, ends[k].z(), false, scratch);
+      } else {  // eq. (4)
+        scratch.addFree(crossingVolume(z_enter, ends[k].z()));
+      }
     }
   };
   walkRayWith(scratch, start.x(), start.y(), 0.0, ends[path].x(), ends[path].y(), 1.0, visit);
@@ -333,9 +334,8 @@ void addReading(const Eigen::Vector3d& start, const Eigen::Vector3d& end, bool o
     });
     return;
   }
-  walkReading(start, end, obstacle, add_hit, scratch, [](double z_enter, double z_exit) {
-    return makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit));
-  });
+  walkReading(start, end, obstacle, add_hit, scratch,
+              [](double z_enter, double z_exit) { return crossingVolume(z_enter, z_exit); });
 }
 
 /// The readings of `scan` (its hits, then its out-of-range readings) that `mine(k)` gives to

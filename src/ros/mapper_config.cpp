@@ -277,7 +277,7 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   read(nh, "insert_out_of_range", insertion.insert_out_of_range);
   read(nh, "model_negative_space", insertion.model_negative_space);
   read(nh, "insertion_threads", insertion.insertion_threads);
-  std::string free_space_rays = "one_path_per_end_column";
+  std::string free_space_rays = "one_per_end_voxel";
   read(nh, "free_space_rays", free_space_rays);
   insertion.free_space_rays = freeSpaceRaysFromName(free_space_rays);
   read(nh, "evidence_limit", insertion.evidence_limit);

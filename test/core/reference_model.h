@@ -53,22 +53,32 @@ class ReferenceModel {
         column_ends;
     using Voxel = std::tuple<std::int32_t, std::int32_t, std::int32_t, bool>;
     std::map<Voxel, std::vector<Eigen::Vector3d>> voxel_ends;
+    // A reading's last cell, entered at z_enter: its free crossing (no return), or its hit's
+    // volume (if with_hit) and the free space up to it.
+    auto last_crossing = [](std::vector<Volume>& free, std::vector<Volume>& hits, double z_enter,
+                            double end_z, bool obstacle, bool with_hit) {
+      if (!obstacle) {
+        free.push_back(makeVolume(static_cast<float>(z_enter), static_cast<float>(end_z)));
+        return;
+      }
+      const auto z = static_cast<float>(end_z);
+      const Volume hit = makeVolume(z - 0.5f, z + 0.5f);
+      if (with_hit) hits.push_back(hit);
+      if (std::fabs(z_enter - end_z) > 1.0) {
+        free.push_back(
+            makeVolume(static_cast<float>(z_enter), z_enter < end_z ? hit.bottom : hit.top));
+      }
+    };
     auto walk = [&](const Eigen::Vector3d& end, bool obstacle, bool with_hit) {
-      const auto end_z = static_cast<float>(end.z());
       walkRay(
           start.x(), start.y(), start.z(), end.x(), end.y(), end.z(),
           [&](const CellIndex& c, double z_enter, double z_exit, bool is_last) {
             auto& [free, hits] = seen[{c.x, c.y}];
-            if (!is_last || !obstacle) {
+            if (!is_last) {
               free.push_back(makeVolume(static_cast<float>(z_enter), static_cast<float>(z_exit)));
               return;
             }
-            const Volume hit = makeVolume(end_z - 0.5f, end_z + 0.5f);
-            if (with_hit) hits.push_back(hit);
-            if (std::fabs(z_enter - end.z()) > 1.0) {
-              free.push_back(makeVolume(static_cast<float>(z_enter),
-                                        z_enter < end.z() ? hit.bottom : hit.top));
-            }
+            last_crossing(free, hits, z_enter, end.z(), obstacle, with_hit);
           });
     };
     auto reading = [&](const Eigen::Vector3f& point, bool is_obstacle) {
@@ -154,17 +164,7 @@ class ReferenceModel {
               return;
             }
             for (const Eigen::Vector3d& end : run) {
-              const double z_enter = height(t_enter, end.z());
-              if (!obstacle) {
-                free.push_back(
-                    makeVolume(static_cast<float>(z_enter), static_cast<float>(end.z())));
-                continue;
-              }
-              const auto end_z = static_cast<float>(end.z());
-              if (std::fabs(z_enter - end.z()) > 1.0) {
-                free.push_back(makeVolume(static_cast<float>(z_enter),
-                                          z_enter < end.z() ? end_z - 0.5f : end_z + 0.5f));
-              }
+              last_crossing(free, hits, height(t_enter, end.z()), end.z(), obstacle, false);
             }
           });
     };

@@ -21,7 +21,7 @@ def test_defaults_are_the_cpp_defaults():
     assert (insertion.min_range, insertion.max_range) == (0.0, math.inf)
     assert insertion.insert_out_of_range and insertion.model_negative_space
     assert insertion.insertion_threads == 1
-    assert insertion.free_space_rays == mvog.FreeSpaceRays.ONE_PATH_PER_END_COLUMN
+    assert insertion.free_space_rays == mvog.FreeSpaceRays.ONE_PER_END_VOXEL
     assert insertion.evidence_limit == 14.0
     planning = mvog.PlanningConfig()
     assert planning.occupancy_threshold == mvog.DEFAULT_OCCUPANCY_THRESHOLD == 0.324

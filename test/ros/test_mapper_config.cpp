@@ -300,8 +300,8 @@ TEST(MapperConfig, RefusesForgettingWithoutDecayAndBadWindows) {
   EXPECT_EQ(refusal(config), "");
 }
 
-TEST(MapperConfig, FreeSpaceRaysDefaultsToOnePathPerEndColumnAndReadsTheThreeNames) {
-  EXPECT_EQ(validConfig().insertion.free_space_rays, mvog::FreeSpaceRays::kOnePathPerEndColumn);
+TEST(MapperConfig, FreeSpaceRaysDefaultsToOnePerEndVoxelAndReadsTheThreeNames) {
+  EXPECT_EQ(validConfig().insertion.free_space_rays, mvog::FreeSpaceRays::kOnePerEndVoxel);
   EXPECT_EQ(freeSpaceRaysFromName("one_path_per_end_column"),
             mvog::FreeSpaceRays::kOnePathPerEndColumn);
   EXPECT_EQ(freeSpaceRaysFromName("one_per_end_voxel"), mvog::FreeSpaceRays::kOnePerEndVoxel);
