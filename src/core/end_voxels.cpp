@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -25,6 +26,7 @@ void EndVoxelIndex::begin() {
 void EndVoxelRays::begin() {
   voxels_.clear();
   index_.begin();
+  last_corner_.setConstant(std::numeric_limits<double>::quiet_NaN());
 }
 
 namespace {
@@ -71,16 +73,19 @@ std::pair<std::uint32_t, bool> EndVoxelIndex::findOrAdd(const EndVoxel& voxel) {
 }
 
 void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end) {
-  last_ = voxel;
+  last_obstacle_ = voxel.obstacle;
+  last_corner_ = cornerOf(voxel);
+  last_centre_ = last_corner_.array() + 0.5;
+  const double distance = (end - last_centre_).squaredNorm();
   const auto [index, added] = index_.findOrAdd(voxel);
   last_index_ = index;
   if (!added) {
-    join(voxels_[index], voxel, end);
+    join(voxels_[index], voxel.obstacle, end, distance);
     return;
   }
   voxels_.push_back({{end},
                      end,
-                     centreDistance(voxel, end),
+                     distance,
                      {voxel.x, voxel.y},
                      static_cast<float>(end.z()),
                      static_cast<float>(end.z()),

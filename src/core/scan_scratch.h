@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <unordered_map>
 #include <utility>
@@ -354,9 +355,6 @@ struct EndVoxel {
   std::int32_t y;
   std::int32_t z;
   bool obstacle;
-  friend bool operator==(const EndVoxel& a, const EndVoxel& b) {
-    return a.x == b.x && a.y == b.y && a.z == b.z && a.obstacle == b.obstacle;
-  }
 };
 
 /// The voxel `end` (grid units) lies in.
@@ -432,12 +430,13 @@ class alignas(kCacheLine) EndVoxelRays {
   /// A reading of the scan ending at `end` (grid units), in an obstacle or not. Inline where it
   /// ends in the voxel of the reading before.
   void offer(const Eigen::Vector3d& end, bool obstacle) {
-    const EndVoxel voxel = endVoxelOf(end, obstacle);
-    if (!voxels_.empty() && voxel == last_) {
-      join(voxels_[last_index_], voxel, end);
+    // floor(g) == k exactly where k <= g < k + 1: the test needs no conversion to integers.
+    if (obstacle == last_obstacle_ && (end.array() >= last_corner_.array()).all() &&
+        (end.array() < last_corner_.array() + 1.0).all()) {
+      join(voxels_[last_index_], obstacle, end, (end - last_centre_).squaredNorm());
       return;
     }
-    offerElsewhere(voxel, end);
+    offerElsewhere(endVoxelOf(end, obstacle), end);
   }
   /// The voxels offered, in the order first offered.
   const std::vector<VoxelReadings>& voxels() const { return voxels_; }
@@ -464,16 +463,17 @@ class alignas(kCacheLine) EndVoxelRays {
  private:
   /// offer() for a reading ending in another voxel than the reading before.
   void offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end);
-  /// Adds a reading of `voxel` to its readings.
-  static void join(VoxelReadings& readings, const EndVoxel& voxel, const Eigen::Vector3d& end) {
+  /// Adds a reading of the voxel of `readings`, ending at `end`, `distance` from its centre.
+  static void join(VoxelReadings& readings, bool obstacle, const Eigen::Vector3d& end,
+                   double distance) {
     if (readings.count < readings.ends.size()) readings.ends[readings.count] = end;
     ++readings.count;
-    if (voxel.obstacle) {
+    if (obstacle) {
       const auto z = static_cast<float>(end.z());
       readings.lowest_hit = std::min(readings.lowest_hit, z);
       readings.highest_hit = std::max(readings.highest_hit, z);
     }
-    keepNearer(readings, end, centreDistance(voxel, end));
+    keepNearer(readings, end, distance);
   }
   /// Makes `end`, `distance` from the voxel's centre, the readings' nearest if it is nearer, or
   /// as near and lower in x, then y, then z: an order in which no two ends tie.
@@ -486,16 +486,20 @@ class alignas(kCacheLine) EndVoxelRays {
       readings.nearest_distance = distance;
     }
   }
-  /// The squared distance from `end` to the centre of its voxel.
-  static double centreDistance(const EndVoxel& voxel, const Eigen::Vector3d& end) {
-    return (end - Eigen::Vector3d(voxel.x + 0.5, voxel.y + 0.5, voxel.z + 0.5)).squaredNorm();
+  /// The corner of `voxel` with the lowest coordinates (grid units).
+  static Eigen::Vector3d cornerOf(const EndVoxel& voxel) {
+    return Eigen::Vector3d(voxel.x, voxel.y, voxel.z);
   }
   EndVoxelIndex index_;  ///< of voxels_
   std::vector<VoxelReadings> voxels_;
-  /// The voxel last offered, and its index: a depth image's neighbouring pixels mostly end in
-  /// one.
-  EndVoxel last_{};
+  /// The voxel last offered: its readings' kind, its index, its corner (cornerOf; NaN, in which
+  /// no end lies, before a scan's first reading) and its centre. A depth image's neighbouring
+  /// pixels mostly end in one.
+  bool last_obstacle_ = false;
   std::uint32_t last_index_ = 0;
+  Eigen::Vector3d last_corner_ =
+      Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Vector3d last_centre_ = Eigen::Vector3d::Zero();
 };
 
 /// Joins the intervals of a list sorted by bottom that come within `join_gap`, in place.
