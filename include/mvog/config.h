@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -84,7 +85,9 @@ struct MapConfig {
   /// Whether `point` (m) is finite and within max_coordinate of the origin along every axis:
   /// the only points readings and queries may reach.
   bool withinBounds(const Eigen::Vector3d& point) const {
-    return point.allFinite() && point.cwiseAbs().maxCoeff() <= max_coordinate;
+    // A NaN or an infinite coordinate fails its comparison (max_coordinate is finite: validate).
+    return std::fabs(point.x()) <= max_coordinate && std::fabs(point.y()) <= max_coordinate &&
+           std::fabs(point.z()) <= max_coordinate;
   }
 
   /// Throws ConfigError naming the first invalid field.
