@@ -85,7 +85,8 @@ struct MapConfig {
   /// Whether `point` (m) is finite and within max_coordinate of the origin along every axis:
   /// the only points readings and queries may reach.
   bool withinBounds(const Eigen::Vector3d& point) const {
-    // A NaN or an infinite coordinate fails its comparison (max_coordinate is finite: validate).
+    // A NaN or an infinite coordinate fails its comparison, max_coordinate being finite in a
+    // validated config (every Map's).
     return std::fabs(point.x()) <= max_coordinate && std::fabs(point.y()) <= max_coordinate &&
            std::fabs(point.z()) <= max_coordinate;
   }

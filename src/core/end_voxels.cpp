@@ -73,24 +73,27 @@ std::pair<std::uint32_t, bool> EndVoxelIndex::findOrAdd(const EndVoxel& voxel) {
 }
 
 void EndVoxelRays::offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end) {
-  last_obstacle_ = voxel.obstacle;
-  last_corner_ = cornerOf(voxel);
-  last_centre_ = last_corner_.array() + 0.5;
-  const double distance = (end - last_centre_).squaredNorm();
+  const Eigen::Vector3d corner = cornerOf(voxel);
+  const Eigen::Vector3d centre = corner.array() + 0.5;
+  const double distance = (end - centre).squaredNorm();
   const auto [index, added] = index_.findOrAdd(voxel);
-  last_index_ = index;
-  if (!added) {
+  if (added) {
+    voxels_.push_back({{end},
+                       end,
+                       distance,
+                       {voxel.x, voxel.y},
+                       static_cast<float>(end.z()),
+                       static_cast<float>(end.z()),
+                       1,
+                       voxel.obstacle});
+  } else {
     join(voxels_[index], voxel.obstacle, end, distance);
-    return;
   }
-  voxels_.push_back({{end},
-                     end,
-                     distance,
-                     {voxel.x, voxel.y},
-                     static_cast<float>(end.z()),
-                     static_cast<float>(end.z()),
-                     1,
-                     voxel.obstacle});
+  // The voxel is the last offered once it holds the reading: offer() may then join it.
+  last_obstacle_ = voxel.obstacle;
+  last_index_ = index;
+  last_corner_ = corner;
+  last_centre_ = centre;
 }
 
 void EndVoxelRays::merge(const EndVoxelRays& other) {

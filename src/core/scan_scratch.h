@@ -463,7 +463,8 @@ class alignas(kCacheLine) EndVoxelRays {
  private:
   /// offer() for a reading ending in another voxel than the reading before.
   void offerElsewhere(const EndVoxel& voxel, const Eigen::Vector3d& end);
-  /// Adds a reading of the voxel of `readings`, ending at `end`, `distance` from its centre.
+  /// Adds a reading of the voxel of `readings`, ending at `end`, at squared distance `distance`
+  /// from its centre.
   static void join(VoxelReadings& readings, bool obstacle, const Eigen::Vector3d& end,
                    double distance) {
     if (readings.count < readings.ends.size()) readings.ends[readings.count] = end;
