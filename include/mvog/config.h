@@ -133,6 +133,9 @@ enum class FreeSpaceRays : std::uint8_t {
   kOnePathPerEndColumn,
 };
 
+/// The most scans InsertionConfig::hit_memory_scans may name: their hits are kept by column.
+constexpr int kMaxHitMemoryScans = 100;
+
 /// How readings are turned into volumes (Sec. III-B).
 struct InsertionConfig {
   /// Obstacle readings closer than this to the sensor (m) are dropped.
@@ -160,6 +163,14 @@ struct InsertionConfig {
   /// MassCounting::kPerReading (the paper's rules) densities count readings, not scans, and are
   /// unbounded whatever it says. Infinity: unbounded.
   double evidence_limit = kDefaultEvidenceLimit;
+  /// Sec. V.B's scan groups: with ModelRules::clip_free_space_at_hits, a scan's free space in a
+  /// column is clipped around the hits of the previous hit_memory_scans scans inserted into the
+  /// map as well as around its own. A laser that grazes a wall in the scans before and after the
+  /// few that hit it then erases those hits less (the corridor's and the tilting laser's surfaces
+  /// called free fall by a sixth to a half, BENCHMARKS.md section 13); a depth camera's noisy hits
+  /// hide the free space beside surfaces for as many scans. 0: a scan's own hits only (the
+  /// paper's). At most kMaxHitMemoryScans. Not saved in the map file.
+  int hit_memory_scans = 0;
 
   /// Throws ConfigError naming the first invalid field.
   void validate() const;

@@ -1,5 +1,7 @@
 #include "mvog/config.h"
 
+#include <string>
+
 #include <cmath>
 
 #include "config_checks.h"
@@ -30,6 +32,8 @@ void InsertionConfig::validate() const {
           "must be in [1, 256]");
   require(evidence_limit >= 1.0, "evidence_limit",
           "must be >= 1 (a scan's own density), infinity for no limit");
+  require(hit_memory_scans >= 0 && hit_memory_scans <= kMaxHitMemoryScans, "hit_memory_scans",
+          "must be in [0, " + std::to_string(kMaxHitMemoryScans) + "]");
   require(free_space_rays == FreeSpaceRays::kEveryReading ||
               free_space_rays == FreeSpaceRays::kOnePerEndVoxel ||
               free_space_rays == FreeSpaceRays::kOnePathPerEndColumn,

@@ -34,9 +34,12 @@ float massOf(const ScanInterval& i, float bottom, float top, bool per_scan, floa
 }
 
 /// The new volumes of one column, as the model's rules make them from what one scan saw there
-/// (`free` and `hits`: sorted, disjoint), masses in the map's stored unit.
+/// (`free` and `hits`: sorted, disjoint), masses in the map's stored unit; the free space clipped
+/// around `clip_at` (sorted by bottom: the scan's hits, and with
+/// InsertionConfig::hit_memory_scans the latest scans' too).
 void addedVolumes(const std::vector<ScanInterval>& free, const std::vector<ScanInterval>& hits,
-                  const ModelRules& rules, float unit_mass, CellVolumes& added) {
+                  const std::vector<ScanInterval>& clip_at, const ModelRules& rules,
+                  float unit_mass, CellVolumes& added) {
   added.positive.clear();
   added.negative.clear();
   const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
@@ -50,14 +53,14 @@ void addedVolumes(const std::vector<ScanInterval>& free, const std::vector<ScanI
       added.negative.push_back({i.bottom, i.top, mass_of(i, i.bottom, i.top)});
       continue;
     }
-    // Sec. V.B: the parts of the free interval outside the scan's own obstacle volumes; a part
-    // lower than kMinVolumeHeight (a sliver beside a hit) is dropped.
+    // Sec. V.B: the parts of the free interval outside the scan's own obstacle volumes (and
+    // its group's); a part lower than kMinVolumeHeight (a sliver beside a hit) is dropped.
     float below = i.bottom;
     auto keep = [&](float bottom, float top) {
       if (top - bottom >= kMinVolumeHeight)
         added.negative.push_back({bottom, top, mass_of(i, bottom, top)});
     };
-    for (const ScanInterval& hit : hits) {
+    for (const ScanInterval& hit : clip_at) {
       if (hit.top <= below) continue;
       if (hit.bottom >= i.top) break;
       keep(below, std::min(hit.bottom, i.top));
@@ -353,7 +356,17 @@ void boundStoredColumn(const detail::ColumnRef& column, double max_density,
                                     CellIndex origin, ColumnWork& work) {
   Volume* stored = const_cast<Volume*>(existing.positive);
   scanColumn(local, hits, detail::joinGapOf(rules), work);
-  addedVolumes(work.free, work.positive, rules, unit_mass, work.added);
+  const std::vector<ScanInterval>* clip_at = &work.positive;
+  if (work.recent_hits != nullptr) {
+    // Sec. V.B's scan groups: the latest scans' hits clip the free space as the scan's own do.
+    work.clip_at.assign(work.positive.begin(), work.positive.end());
+    work.recent_hits->append(detail::cellKey(detail::cellInTile(origin, local)),
+                             work.hit_memory_scans, work.clip_at);
+    std::sort(work.clip_at.begin(), work.clip_at.end(),
+              [](const ScanInterval& a, const ScanInterval& b) { return a.bottom < b.bottom; });
+    clip_at = &work.clip_at;
+  }
+  addedVolumes(work.free, work.positive, *clip_at, rules, unit_mass, work.added);
   const FreeSpaceRules free_space_rules = detail::freeSpaceRulesOf(rules);
   if (work.added.positive.empty()
           ? addCoveredFreeSpace(work.added.negative, stored + existing.num_positive,
@@ -410,8 +423,12 @@ MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
   const CellIndex origin = detail::tileOrigin(key);
   const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
   HitCursor hit_cursor(work.hits);
-  // With one thread's part, a cell's free space may be one interval read from it directly.
-  const auto* only_part = work.parts.size() == 1 ? &work.parts[0] : nullptr;
+  // With one thread's part, a cell's free space may be one interval read from it directly;
+  // not in a tile where InsertionConfig::hit_memory_scans's recent hits may clip it
+  // (updateColumn).
+  const bool remembered =
+      work.recent_hits != nullptr && work.recent_hits->holdsTile(key, work.hit_memory_scans);
+  const auto* only_part = work.parts.size() == 1 && !remembered ? &work.parts[0] : nullptr;
   const detail::TileBlock::Layout layout(tile);
   for (std::size_t word = 0; word < std::size(work.reached); ++word) {
     for (std::uint64_t bits = work.reached[word]; bits != 0; bits &= bits - 1) {
@@ -485,7 +502,14 @@ InsertionResult Map::apply(ScanUpdate& update) {
       if (!tile->reachedNone()) keys.push_back(key);
     }
   }
-  if (keys.empty()) return impl.result;
+  // InsertionConfig::hit_memory_scans: with Sec. V.B's clipping, the latest scans' hits clip
+  // this one's free space too.
+  const int hit_memory_scans =
+      config_.rules.clip_free_space_at_hits ? impl.insertion.hit_memory_scans : 0;
+  if (keys.empty()) {
+    storage_->recent_hits.endScan(impl.scratches, hit_memory_scans);
+    return impl.result;
+  }
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   ++revision_;
@@ -502,7 +526,11 @@ InsertionResult Map::apply(ScanUpdate& update) {
   const std::size_t num_threads = impl.scratches.size();
   std::vector<ColumnWork>& work = impl.column_work;
   if (work.size() < num_threads) work.resize(num_threads);
-  for (ColumnWork& w : work) w.grown = kNoCells;
+  for (ColumnWork& w : work) {
+    w.grown = kNoCells;
+    w.recent_hits = hit_memory_scans > 0 ? &storage_->recent_hits : nullptr;
+    w.hit_memory_scans = hit_memory_scans;
+  }
   auto update_tile = [&](std::size_t worker, std::size_t k) {
     detail::TileBlock& tile = *tiles[k];
     const double rescale = tile.empty() ? 1.0 : rescaleOf(tile.exponent());
@@ -518,6 +546,7 @@ InsertionResult Map::apply(ScanUpdate& update) {
     if (tiles[k]->empty()) storage_->tiles.erase(keys[k]);
   }
   for (const ColumnWork& w : work) bounds_.extend(w.grown);
+  storage_->recent_hits.endScan(impl.scratches, hit_memory_scans);
   return impl.result;
 }
 

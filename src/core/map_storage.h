@@ -9,6 +9,7 @@
 
 #include "mvog/constraints.h"
 #include "mvog/map.h"
+#include "recent_hits.h"
 #include "tile_block.h"
 
 namespace mvog {
@@ -62,6 +63,8 @@ struct Map::Storage {
   /// stored form changed, so an incremental update cannot span it.
   std::uint64_t exponents_rebased_revision = 0;
   std::uint64_t id = detail::newMapId();
+  /// The latest scans' hits (InsertionConfig::hit_memory_scans).
+  detail::RecentHits recent_hits;
 
   /// Erases a tile, remembering its removal at `revision`; returns the tile after it.
   Tiles::iterator removeTile(Tiles::iterator tile, std::uint64_t revision) {

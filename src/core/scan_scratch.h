@@ -683,9 +683,15 @@ inline float joinGapOf(const ModelRules& rules) {
   return rules.mass_counting == MassCounting::kPerScan ? kMaxMergeGap : 0.0f;
 }
 
+class RecentHits;
+
 /// One thread's working memory while Map::apply applies a scan (ScanUpdate::Impl keeps it from
 /// scan to scan).
 struct alignas(kCacheLine) ColumnWork {
+  /// The map's recent hits that clip the scan's free space (InsertionConfig::hit_memory_scans),
+  /// or null, and those of how many scans.
+  const RecentHits* recent_hits = nullptr;
+  int hit_memory_scans = 0;
   ListMerger merger;
   /// The scratches that reached the tile being updated, and their part of it.
   std::vector<std::pair<const ScanScratch*, const ScratchTile*>> parts;
@@ -694,6 +700,8 @@ struct alignas(kCacheLine) ColumnWork {
   std::uint64_t reached[kCellsPerTile / 64];  // the cells the scan reached
   std::vector<ScanInterval> free;
   std::vector<ScanInterval> positive;
+  /// The scan's hits and the recent ones, by bottom: where its free space is clipped.
+  std::vector<ScanInterval> clip_at;
   CellVolumes added;
   std::vector<double> evidence_factors;  // boundEvidence's
   CellVolumes merged;

@@ -184,13 +184,16 @@ void bindConfigs(py::module_& module) {
       .field("evidence_limit", &mvog::InsertionConfig::evidence_limit,
              "Scans of evidence a height keeps (bounded evidence, OctoMap's clamping); >= 1, inf "
              "for none. Unbounded with per-reading masses (the paper's rules).")
+      .field("hit_memory_scans", &mvog::InsertionConfig::hit_memory_scans,
+             "Scans before a scan whose hits clip its free space as its own do (Sec. V.B's scan "
+             "groups, with clip_free_space_at_hits); 0 (its own only) to 100.")
       .done()
       .def(py::init([](double min_range, double max_range, bool insert_out_of_range,
                        bool model_negative_space, int threads, mvog::FreeSpaceRays rays,
-                       double evidence_limit) {
+                       double evidence_limit, int hit_memory_scans) {
              return validated(mvog::InsertionConfig{min_range, max_range, insert_out_of_range,
                                                     model_negative_space, threads, rays,
-                                                    evidence_limit});
+                                                    evidence_limit, hit_memory_scans});
            }),
            py::kw_only(), py::arg("min_range") = insertion.min_range,
            py::arg("max_range") = insertion.max_range,
@@ -198,7 +201,8 @@ void bindConfigs(py::module_& module) {
            py::arg("model_negative_space") = insertion.model_negative_space,
            py::arg("insertion_threads") = insertion.insertion_threads,
            py::arg("free_space_rays") = insertion.free_space_rays,
-           py::arg("evidence_limit") = insertion.evidence_limit);
+           py::arg("evidence_limit") = insertion.evidence_limit,
+           py::arg("hit_memory_scans") = insertion.hit_memory_scans);
 
   const mvog::PlanningConfig planning;
   ConfigClass<mvog::PlanningConfig>(module, "PlanningConfig",

@@ -281,6 +281,7 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   read(nh, "free_space_rays", free_space_rays);
   insertion.free_space_rays = freeSpaceRaysFromName(free_space_rays);
   read(nh, "evidence_limit", insertion.evidence_limit);
+  read(nh, "hit_memory_scans", insertion.hit_memory_scans);
   read(nh, "insertion_queue_size", insertion.insertion_queue_size);
   read(nh, "backlog_insertion_threads", insertion.backlog_insertion_threads);
 

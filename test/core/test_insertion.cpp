@@ -1074,6 +1074,89 @@ TEST(Rules, ClippingIsWithinOneScan) {
   EXPECT_FLOAT_EQ(*at_hit.probability, 0.5f);  // one hit, one pass: each counted once
 }
 
+/// A scan from (0.5, 0.5, 0.5) of one hit at (3.5, 0.5, 0.5) (cell (3, 0), its volume [0, 1]).
+Scan scanHittingCellThree() {
+  Scan scan;
+  scan.origin = {0.5, 0.5, 0.5};
+  scan.hits.push_back({3.5f, 0.5f, 0.5f});
+  return scan;
+}
+
+/// A level scan from the same origin whose ray passes through cell (3, 0) to a hit at 6.5.
+Scan scanThroughCellThree() {
+  Scan scan = scanHittingCellThree();
+  scan.hits = {{6.5f, 0.5f, 0.5f}};
+  return scan;
+}
+
+TEST(Rules, HitMemoryClipsTheNextScansFreeSpaceAroundTheHitsBeforeIt) {
+  // Sec. V.B's scan groups (InsertionConfig::hit_memory_scans): the second scan's ray through the
+  // first scan's hit adds no free space there while the first scan is within the memory; the
+  // third scan's, one scan later, does (ClippingIsWithinOneScan: 0, a scan's own hits only).
+  Map map(unitConfig(10000.0, ModelRules{}));
+  InsertionConfig insertion;
+  insertion.hit_memory_scans = 1;
+  map.insertScan(scanHittingCellThree(), insertion);
+  map.insertScan(scanThroughCellThree(), insertion);
+  EXPECT_TRUE(map.cellVolumes({3, 0}).negative.empty());
+  EXPECT_FLOAT_EQ(*map.occupancy({3.5, 0.5, 0.5}).probability, 1.0f);
+  EXPECT_FALSE(map.cellVolumes({2, 0}).negative.empty());  // no hit there: freed as ever
+  map.insertScan(scanThroughCellThree(), insertion);
+  EXPECT_FLOAT_EQ(*map.occupancy({3.5, 0.5, 0.5}).probability, 0.5f);  // one hit, one pass
+}
+
+TEST(Rules, HitMemoryKeepsTheFreeSpaceAboveAndBelowARememberedHit) {
+  // A steep ray through the column of the first scan's hit keeps its free space outside the
+  // hit's volume [0, 1], as the clipping of a scan's own hits does: no free mass at the hit.
+  Map map(unitConfig(10000.0, ModelRules{}));
+  InsertionConfig insertion;
+  insertion.hit_memory_scans = 2;
+  map.insertScan(scanHittingCellThree(), insertion);
+  Scan steep;
+  steep.origin = {3.5, 0.5, 10.5};
+  steep.hits = {{3.5f, 0.5f, -9.5f}};
+  map.insertScan(steep, insertion);
+  EXPECT_EQ(map.occupancy({3.5, 0.5, 5.5}).state(0.5), OccupancyState::kFree);
+  EXPECT_EQ(map.occupancy({3.5, 0.5, -5.5}).state(0.5), OccupancyState::kFree);
+  EXPECT_FLOAT_EQ(*map.occupancy({3.5, 0.5, 0.5}).probability, 1.0f);
+}
+
+TEST(Rules, HitMemoryNeedsClippingAtHits) {
+  // Without Sec. V.B's clipping (clip_free_space_at_hits off) no hit clips free space, its own
+  // or its group's: the second scan frees the first one's hit as with no memory.
+  ModelRules rules;
+  rules.clip_free_space_at_hits = false;
+  Map map(unitConfig(10000.0, rules));
+  InsertionConfig insertion;
+  insertion.hit_memory_scans = 3;
+  map.insertScan(scanHittingCellThree(), insertion);
+  map.insertScan(scanThroughCellThree(), insertion);
+  EXPECT_FLOAT_EQ(*map.occupancy({3.5, 0.5, 0.5}).probability, 0.5f);
+}
+
+TEST(Rules, HitMemoryBuildsTheSameMapWithAnyThreads) {
+  // The recent hits are read by every thread's tiles and recorded after the scan: 1 to 3
+  // threads build the same map, which the memory changes.
+  MapConfig map_config;
+  map_config.resolution = 0.25;
+  const std::vector<Scan> scans = testScans(7);
+  std::vector<std::vector<test::VolumeRecord>> maps;
+  for (int threads = 1; threads <= 3; ++threads) {
+    Map map(map_config);
+    InsertionConfig insertion;
+    insertion.insertion_threads = threads;
+    insertion.hit_memory_scans = 2;
+    for (const Scan& scan : scans) map.insertScan(scan, insertion);
+    maps.push_back(allVolumes(map));
+  }
+  for (int threads = 2; threads <= 3; ++threads) {
+    EXPECT_TRUE(test::sameVolumes(maps[threads - 1], maps[0])) << threads << " threads";
+  }
+  Map without(map_config);
+  for (const Scan& scan : scans) without.insertScan(scan);
+  EXPECT_FALSE(test::sameVolumes(allVolumes(without), maps[0]));
+}
+
 TEST(Rules, PerScanAHeightCountsOncePerScan) {
   // 100 rays of one scan through cell (2, 0) at the same height, ending in cell (5, 0).
   Scan scan;

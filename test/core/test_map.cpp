@@ -586,6 +586,9 @@ TEST(Config, InsertionConfigFieldsAreChecked) {
          c.max_range = 5.0;
        }),
        "min_range"},
+      {with([](InsertionConfig& c) { c.hit_memory_scans = -1; }), "hit_memory_scans"},
+      {with([](InsertionConfig& c) { c.hit_memory_scans = kMaxHitMemoryScans + 1; }),
+       "hit_memory_scans"},
       {with([](InsertionConfig& c) { c.insertion_threads = 0; }), "insertion_threads"},
       {with([](InsertionConfig& c) { c.insertion_threads = -2; }), "insertion_threads"},
       {with([](InsertionConfig& c) { c.insertion_threads = 257; }), "insertion_threads"}};

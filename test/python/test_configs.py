@@ -23,6 +23,7 @@ def test_defaults_are_the_cpp_defaults():
     assert insertion.insertion_threads == 1
     assert insertion.free_space_rays == mvog.FreeSpaceRays.ONE_PER_END_VOXEL
     assert insertion.evidence_limit == 14.0
+    assert insertion.hit_memory_scans == 0
     planning = mvog.PlanningConfig()
     assert planning.occupancy_threshold == mvog.DEFAULT_OCCUPANCY_THRESHOLD == 0.324
     assert planning.max_query_cells == 50000000
@@ -60,6 +61,7 @@ def test_keyword_arguments_only():
     (lambda: mvog.InsertionConfig(min_range=5.0, max_range=2.0), "min_range"),
     (lambda: mvog.InsertionConfig(insertion_threads=0), "insertion_threads"),
     (lambda: mvog.InsertionConfig(evidence_limit=0.5), "evidence_limit"),
+    (lambda: mvog.InsertionConfig(hit_memory_scans=101), "hit_memory_scans"),
     (lambda: mvog.PlanningConfig(occupancy_threshold=1.0), "occupancy_threshold"),
     (lambda: mvog.PlanningConfig(max_query_cells=0), "max_query_cells"),
     (lambda: mvog.PlanningConfig(frontier_min_z=2.0, frontier_max_z=1.0), "frontier_min_z"),

@@ -340,6 +340,17 @@ TEST(MapperConfig, EvidenceLimitDefaultsToTheCoresAndRefusesLessThanOneNamingIt)
   }
 }
 
+TEST(MapperConfig, HitMemoryDefaultsToNoneAndRefusesOutOfRangeNamingIt) {
+  EXPECT_EQ(validConfig().insertion.hit_memory_scans, 0);
+  MapperConfig laser = validConfig();
+  laser.insertion.hit_memory_scans = 3;
+  EXPECT_EQ(refusal(laser), "");
+  for (int scans : {-1, mvog::kMaxHitMemoryScans + 1}) {
+    expectRefused({"hit_memory_scans", std::to_string(scans),
+                   [scans](MapperConfig& c) { c.insertion.hit_memory_scans = scans; }});
+  }
+}
+
 TEST(MapperConfig, AnEmptyAutosaveFileIsFineWhileAutosaveIsOff) {
   MapperConfig config = validConfig();
   config.map_files.autosave_file.clear();

@@ -53,6 +53,7 @@ MvogRun runMvog(const InputData& input, const RunOptions& options) {
   insertion.insertion_threads = options.threads;
   insertion.free_space_rays = options.free_space_rays;
   insertion.evidence_limit = options.evidence_limit;
+  insertion.hit_memory_scans = options.hit_memory_scans;
   MvogRun run{mvog::Map(map_config), {}};
   MvogStats& stats = run.stats;
   stats.threads = options.threads;

@@ -36,6 +36,8 @@ struct RunOptions {
   bool octomap_clamping = true;
   /// MVOG only: InsertionConfig::evidence_limit.
   double evidence_limit = mvog::InsertionConfig{}.evidence_limit;
+  /// MVOG only: InsertionConfig::hit_memory_scans.
+  int hit_memory_scans = mvog::InsertionConfig{}.hit_memory_scans;
 };
 
 /// Seconds from `start` to now (steady clock): what each backend's insertion took.

@@ -6,7 +6,7 @@
 //              [--model default|paper] [--clip-free-space-at-hits on|off]
 //              [--mass-counting per-scan|per-reading] [--split-free-space-at-obstacles on|off]
 //              [--free-space-rays one-path-per-end-column|one-per-end-voxel|every-reading]
-//              [--octomap-clamping on|off] [--evidence-limit E|inf]
+//              [--octomap-clamping on|off] [--evidence-limit E|inf] [--hit-memory-scans S]
 //              [--truth-slice OUT.ppm]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
 #include <algorithm>
@@ -43,6 +43,7 @@ struct Arguments {
   mvog::FreeSpaceRays free_space_rays = mvog::InsertionConfig{}.free_space_rays;
   bool octomap_clamping = true;
   double evidence_limit = mvog::InsertionConfig{}.evidence_limit;
+  int hit_memory_scans = mvog::InsertionConfig{}.hit_memory_scans;
   bool run_mvog = false;
   bool run_octomap = false;
   bool run_bonxai = false;
@@ -70,6 +71,7 @@ constexpr const char* kUsage =
     "                  [--free-space-rays one-path-per-end-column|one-per-end-voxel|\n"
     "                                     every-reading]\n"
     "                  [--octomap-clamping on|off] [--evidence-limit E|inf]\n"
+    "                  [--hit-memory-scans S]\n"
     "                  [--truth-slice OUT.ppm]\n"
     "  FILE        a ROS bag (LaserScan, PointCloud2 and/or depth Image 16UC1 or 32FC1 with\n"
     "              CameraInfo; poses from /tf and /tf_static)\n"
@@ -101,6 +103,9 @@ constexpr const char* kUsage =
     "              column's run of end voxels or every reading's (mvog::FreeSpaceRays)\n"
     "  E           MVOG's evidence limit in scans, with per-scan masses\n"
     "              (mvog::InsertionConfig::evidence_limit; default 14)\n"
+    "  S           MVOG clips a scan's free space around the hits of the S scans before it\n"
+    "              too, with clip_free_space_at_hits (Sec. V.B's scan groups;\n"
+    "              mvog::InsertionConfig::hit_memory_scans; default 0: its own only)\n"
     "  --octomap-clamping  OctoMap's log-odds clamped at each update (on, its default) or\n"
     "              not (off: every hit and miss counts, as MVOG's masses do)\n"
     "  --truth-slice  with truth:NAME, a cross-section of the scene with each map's errors\n"
@@ -116,12 +121,12 @@ double positiveNumber(const std::string& option, const std::string& text) {
   return value;
 }
 
-int wholeNumber(const std::string& option, const std::string& text, int max) {
+int wholeNumber(const std::string& option, const std::string& text, int min, int max) {
   char* end = nullptr;
   const long value = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || value < 1 || value > max) {
-    throw UsageError(option + " needs a whole number in [1, " + std::to_string(max) + "], got '" +
-                     text + "'");
+  if (text.empty() || *end != '\0' || value < min || value > max) {
+    throw UsageError(option + " needs a whole number in [" + std::to_string(min) + ", " +
+                     std::to_string(max) + "], got '" + text + "'");
   }
   return static_cast<int>(value);
 }
@@ -147,9 +152,9 @@ Arguments parseArguments(int argc, char** argv) {
     } else if (option == "--max-range") {
       arguments.max_range = positiveNumber(option, value);
     } else if (option == "--threads") {
-      arguments.threads = wholeNumber(option, value, 256);
+      arguments.threads = wholeNumber(option, value, 1, 256);
     } else if (option == "--repeat") {
-      arguments.repeat = wholeNumber(option, value, 100);
+      arguments.repeat = wholeNumber(option, value, 1, 100);
     } else if (option == "--backend") {
       if (value != "mvog" && value != "octomap" && value != "bonxai" && value != "walk" &&
           value != "every-reading" && value != "both" && value != "all") {
@@ -205,6 +210,8 @@ Arguments parseArguments(int argc, char** argv) {
     } else if (option == "--evidence-limit") {
       arguments.evidence_limit =
           value == "inf" ? std::numeric_limits<double>::infinity() : positiveNumber(option, value);
+    } else if (option == "--hit-memory-scans") {
+      arguments.hit_memory_scans = wholeNumber(option, value, 0, mvog::kMaxHitMemoryScans);
     } else if (option == "--octomap-clamping") {
       arguments.octomap_clamping = onOff(option, value);
     } else if (option == "--json") {
@@ -264,6 +271,7 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   options.free_space_rays = arguments.free_space_rays;
   options.octomap_clamping = arguments.octomap_clamping;
   options.evidence_limit = arguments.evidence_limit;
+  options.hit_memory_scans = arguments.hit_memory_scans;
   mvog_bench::ResolutionReport report;
   report.resolution = resolution;
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
@@ -417,6 +425,8 @@ int main(int argc, char** argv) {
     mvog::InsertionConfig insertion;
     insertion.evidence_limit = arguments.evidence_limit;
     report.evidence_limit = insertion.appliedEvidenceLimit(arguments.rules);
+    report.hit_memory_scans =
+        arguments.rules.clip_free_space_at_hits ? arguments.hit_memory_scans : 0;
     report.out_of_range = arguments.out_of_range;
     report.repeat = arguments.repeat;
     const auto start = std::chrono::steady_clock::now();

@@ -256,10 +256,12 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
   } else {
     std::fprintf(out, "max range   none\n");
   }
-  std::fprintf(out, "MVOG rules  %s%s; occupied where p > %.3f; evidence limit %g\n",
+  std::fprintf(out,
+               "MVOG rules  %s%s; occupied where p > %.3f; evidence limit %g; hit memory %d "
+               "scans\n",
                rulesText(report.rules).c_str(),
                report.rules == mvog::ModelRules::paper() ? " (the paper's model)" : "",
-               report.occupancy_threshold, report.evidence_limit);
+               report.occupancy_threshold, report.evidence_limit, report.hit_memory_scans);
   std::fprintf(out, "OctoMap     log-odds clamping %s\n\n",
                report.octomap_clamping ? "on (its default)" : "off");
 
@@ -541,6 +543,7 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
       .add("occupancy_threshold", report.occupancy_threshold)
       .add("octomap_clamping", report.octomap_clamping)
       .add("evidence_limit", report.evidence_limit)
+      .add("hit_memory_scans", report.hit_memory_scans)
       .add("repeat", report.repeat)
       .add("table_one", table_one)
       .add("quality", quality)

@@ -47,6 +47,7 @@ struct BenchReport {
   double occupancy_threshold = 0.0;
   bool octomap_clamping = true;  ///< RunOptions::octomap_clamping
   double evidence_limit = 0.0;   ///< RunOptions::evidence_limit, as applied (infinity: none)
+  int hit_memory_scans = 0;      ///< RunOptions::hit_memory_scans, as applied
   bool out_of_range = false;     ///< the out-of-range readings were given to MVOG
   int repeat = 1;                ///< insertions per backend; the fastest is reported
   std::vector<ResolutionReport> resolutions;
