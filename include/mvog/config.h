@@ -165,11 +165,14 @@ struct InsertionConfig {
   double evidence_limit = kDefaultEvidenceLimit;
   /// Sec. V.B's scan groups: with ModelRules::clip_free_space_at_hits, a scan's free space in a
   /// column is clipped around the hits of the previous hit_memory_scans scans inserted into the
-  /// map as well as around its own. A laser that grazes a wall in the scans before and after the
-  /// few that hit it then erases those hits less (the corridor's and the tilting laser's surfaces
-  /// called free fall by a sixth to a half, BENCHMARKS.md section 13); a depth camera's noisy hits
-  /// hide the free space beside surfaces for as many scans. 0: a scan's own hits only (the
-  /// paper's). At most kMaxHitMemoryScans. Not saved in the map file.
+  /// map as well as around its own (joined as its own are). A laser that grazes a wall in the
+  /// scans before and after the few that hit it then erases those hits less (the corridor's and
+  /// the tilting laser's surfaces called free fall by a sixth to a half, BENCHMARKS.md section
+  /// 13); a depth camera's noisy hits hide the free space beside surfaces for as many scans.
+  /// Every insertion into the map counts as a scan (an empty one, a single reading), and one
+  /// with 0 forgets the hits kept, as Map::clear does; they are held beside the map
+  /// (Map::memoryUsage). 0: a scan's own hits only (the paper's). At most kMaxHitMemoryScans.
+  /// Not saved in the map file.
   int hit_memory_scans = 0;
 
   /// Throws ConfigError naming the first invalid field.

@@ -1,6 +1,7 @@
 // The second half of the scan update of Fig. 2: the constraints applied once to every list the
 // scan modified (Sec. III-B.3), with the model's rules (Sec. V.B, V.C).
 #include <algorithm>
+#include <memory>
 #include <tuple>
 
 #include "map_storage.h"
@@ -357,13 +358,15 @@ void boundStoredColumn(const detail::ColumnRef& column, double max_density,
   Volume* stored = const_cast<Volume*>(existing.positive);
   scanColumn(local, hits, detail::joinGapOf(rules), work);
   const std::vector<ScanInterval>* clip_at = &work.positive;
-  if (work.recent_hits != nullptr) {
-    // Sec. V.B's scan groups: the latest scans' hits clip the free space as the scan's own do.
+  if (work.tile_remembered) {
+    // Sec. V.B's scan groups: the latest scans' hits clip the free space as the scan's own do,
+    // joined as a scan's own are (whichever scan saw them).
     work.clip_at.assign(work.positive.begin(), work.positive.end());
     work.recent_hits->append(detail::cellKey(detail::cellInTile(origin, local)),
                              work.hit_memory_scans, work.clip_at);
     std::sort(work.clip_at.begin(), work.clip_at.end(),
               [](const ScanInterval& a, const ScanInterval& b) { return a.bottom < b.bottom; });
+    detail::joinSorted(work.clip_at, detail::joinGapOf(rules));
     clip_at = &work.clip_at;
   }
   addedVolumes(work.free, work.positive, *clip_at, rules, unit_mass, work.added);
@@ -426,9 +429,10 @@ MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
   // With one thread's part, a cell's free space may be one interval read from it directly;
   // not in a tile where InsertionConfig::hit_memory_scans's recent hits may clip it
   // (updateColumn).
-  const bool remembered =
+  work.tile_remembered =
       work.recent_hits != nullptr && work.recent_hits->holdsTile(key, work.hit_memory_scans);
-  const auto* only_part = work.parts.size() == 1 && !remembered ? &work.parts[0] : nullptr;
+  const auto* only_part =
+      work.parts.size() == 1 && !work.tile_remembered ? &work.parts[0] : nullptr;
   const detail::TileBlock::Layout layout(tile);
   for (std::size_t word = 0; word < std::size(work.reached); ++word) {
     for (std::uint64_t bits = work.reached[word]; bits != 0; bits &= bits - 1) {
@@ -506,8 +510,14 @@ InsertionResult Map::apply(ScanUpdate& update) {
   // this one's free space too.
   const int hit_memory_scans =
       config_.rules.clip_free_space_at_hits ? impl.insertion.hit_memory_scans : 0;
+  std::unique_ptr<detail::RecentHits>& recent_hits = storage_->recent_hits;
+  if (hit_memory_scans == 0) {
+    recent_hits.reset();
+  } else if (recent_hits == nullptr) {
+    recent_hits = std::make_unique<detail::RecentHits>();
+  }
   if (keys.empty()) {
-    storage_->recent_hits.endScan(impl.scratches, hit_memory_scans);
+    if (recent_hits != nullptr) recent_hits->endScan(impl.scratches, hit_memory_scans);
     return impl.result;
   }
   std::sort(keys.begin(), keys.end());
@@ -528,7 +538,7 @@ InsertionResult Map::apply(ScanUpdate& update) {
   if (work.size() < num_threads) work.resize(num_threads);
   for (ColumnWork& w : work) {
     w.grown = kNoCells;
-    w.recent_hits = hit_memory_scans > 0 ? &storage_->recent_hits : nullptr;
+    w.recent_hits = recent_hits.get();
     w.hit_memory_scans = hit_memory_scans;
   }
   auto update_tile = [&](std::size_t worker, std::size_t k) {
@@ -546,7 +556,7 @@ InsertionResult Map::apply(ScanUpdate& update) {
     if (tiles[k]->empty()) storage_->tiles.erase(keys[k]);
   }
   for (const ColumnWork& w : work) bounds_.extend(w.grown);
-  storage_->recent_hits.endScan(impl.scratches, hit_memory_scans);
+  if (recent_hits != nullptr) recent_hits->endScan(impl.scratches, hit_memory_scans);
   return impl.result;
 }
 

@@ -138,8 +138,9 @@ MemoryUsage Map::memoryUsage() const {
   const std::size_t tile_index_bytes =
       tiles.bucket_count() * sizeof(void*) +
       tiles.size() * (sizeof(void*) + sizeof(std::uint64_t) + sizeof(detail::TileBlock));
-  usage.bytes_held =
-      sizeof(Map) + sizeof(Storage) + tile_index_bytes + tile_bytes + storage_->removals.bytes();
+  usage.bytes_held = sizeof(Map) + sizeof(Storage) + tile_index_bytes + tile_bytes +
+                     storage_->removals.bytes() +
+                     (storage_->recent_hits != nullptr ? storage_->recent_hits->bytes() : 0);
   usage.minimal_grid_cells = static_cast<std::size_t>(bounds_.width() * bounds_.height());
   usage.table_one_bytes = usage.minimal_grid_cells * 8 +
                           (usage.positive_volumes + usage.negative_volumes) * sizeof(Volume);
@@ -148,6 +149,7 @@ MemoryUsage Map::memoryUsage() const {
 
 void Map::clear() {
   storage_->tiles.clear();
+  storage_->recent_hits.reset();
   bounds_ = kNoCells;
   mass_unit_ = 1.0;
   unit_exponent_ = 0;

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -63,8 +64,9 @@ struct Map::Storage {
   /// stored form changed, so an incremental update cannot span it.
   std::uint64_t exponents_rebased_revision = 0;
   std::uint64_t id = detail::newMapId();
-  /// The latest scans' hits (InsertionConfig::hit_memory_scans).
-  detail::RecentHits recent_hits;
+  /// The latest scans' hits (InsertionConfig::hit_memory_scans): made by the first insertion
+  /// that keeps them, dropped by one that does not and by Map::clear.
+  std::unique_ptr<detail::RecentHits> recent_hits;
 
   /// Erases a tile, remembering its removal at `revision`; returns the tile after it.
   Tiles::iterator removeTile(Tiles::iterator tile, std::uint64_t revision) {

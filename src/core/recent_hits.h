@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -15,11 +16,14 @@ class RecentHits {
  public:
   /// Whether tile `tile_key` (tileKey) holds a hit of the last `scans` scans.
   bool holdsTile(std::uint64_t tile_key, int scans) const;
-  /// Appends the hits of column `cell_key` in the last `scans` scans to `out` (grid units).
+  /// Appends the hits of column `cell_key` (cellKey) in the last `scans` scans to `out` (grid
+  /// units).
   void append(std::uint64_t cell_key, int scans, std::vector<ScanInterval>& out) const;
-  /// Ends a scan: the hits of `scratches` are kept while `scans` more scans are inserted (none
-  /// for 0: every hit kept is forgotten).
+  /// Ends a scan: the hits of `scratches` are kept while `scans` (at least 1) more scans are
+  /// inserted.
   void endScan(const std::vector<ScanScratch>& scratches, int scans);
+  /// The bytes held (Map::memoryUsage).
+  std::size_t bytes() const;
 
  private:
   struct Hit {
@@ -31,13 +35,13 @@ class RecentHits {
   bool within(std::uint64_t scan, int scans) const {
     return scan + static_cast<std::uint64_t>(scans) > scans_ended_;
   }
-  /// Forgets the hits of `column` older than the last `scans` scans.
-  void forgetOld(std::vector<Hit>& column, int scans) const;
 
+  /// Each column's hits, oldest first.
   std::unordered_map<std::uint64_t, std::vector<Hit>> by_column_;
-  /// The last scan with a hit in each tile (Map::apply's fast path passes the others).
+  /// The last scan with a hit in each tile (Map::apply's shortcut passes the others).
   std::unordered_map<std::uint64_t, std::uint64_t> last_scan_of_tile_;
   std::uint64_t scans_ended_ = 0;
+  std::uint64_t last_purge_ = 0;  ///< scans_ended_ when every column was last purged
 };
 
 }  // namespace detail

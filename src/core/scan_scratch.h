@@ -689,9 +689,10 @@ class RecentHits;
 /// scan to scan).
 struct alignas(kCacheLine) ColumnWork {
   /// The map's recent hits that clip the scan's free space (InsertionConfig::hit_memory_scans),
-  /// or null, and those of how many scans.
+  /// or null, those of how many scans, and whether the tile being updated holds some.
   const RecentHits* recent_hits = nullptr;
   int hit_memory_scans = 0;
+  bool tile_remembered = false;
   ListMerger merger;
   /// The scratches that reached the tile being updated, and their part of it.
   std::vector<std::pair<const ScanScratch*, const ScratchTile*>> parts;

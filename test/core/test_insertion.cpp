@@ -1121,6 +1121,31 @@ TEST(Rules, HitMemoryKeepsTheFreeSpaceAboveAndBelowARememberedHit) {
   EXPECT_FLOAT_EQ(*map.occupancy({3.5, 0.5, 0.5}).probability, 1.0f);
 }
 
+TEST(Rules, HitMemoryForgetsAfterItsScansAfterAnInsertionWithoutItAndAfterClear) {
+  // With 2 the hit clips the next two scans' free space, not the third's; an insertion with 0,
+  // or Map::clear, forgets the hits kept.
+  auto passes_until_freed = [](auto between) {
+    Map map(unitConfig(10000.0, ModelRules{}));
+    InsertionConfig insertion;
+    insertion.hit_memory_scans = 2;
+    map.insertScan(scanHittingCellThree(), insertion);
+    between(map);
+    int passes = 0;
+    while (map.cellVolumes({3, 0}).negative.empty() && passes < 5) {
+      map.insertScan(scanThroughCellThree(), insertion);
+      ++passes;
+    }
+    return passes;
+  };
+  EXPECT_EQ(passes_until_freed([](Map&) {}), 3);
+  EXPECT_EQ(passes_until_freed([](Map& map) {
+              InsertionConfig without;  // hit_memory_scans 0
+              map.insertScan(Scan{{0.5, 0.5, 0.5}, {{0.5f, 5.5f, 0.5f}}, {}}, without);
+            }),
+            1);
+  EXPECT_EQ(passes_until_freed([](Map& map) { map.clear(); }), 1);
+}
+
 TEST(Rules, HitMemoryNeedsClippingAtHits) {
   // Without Sec. V.B's clipping (clip_free_space_at_hits off) no hit clips free space, its own
   // or its group's: the second scan frees the first one's hit as with no memory.
