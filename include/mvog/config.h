@@ -183,6 +183,11 @@ struct InsertionConfig {
     return rules.mass_counting == MassCounting::kPerScan ? evidence_limit
                                                          : std::numeric_limits<double>::infinity();
   }
+  /// The scans whose hits an insertion into a map of `rules` remembers: hit_memory_scans with
+  /// ModelRules::clip_free_space_at_hits, none without (no hit clips free space then).
+  int appliedHitMemoryScans(const ModelRules& rules) const {
+    return rules.clip_free_space_at_hits ? hit_memory_scans : 0;
+  }
 };
 
 }  // namespace mvog

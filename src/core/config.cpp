@@ -1,8 +1,7 @@
 #include "mvog/config.h"
 
-#include <string>
-
 #include <cmath>
+#include <string>
 
 #include "config_checks.h"
 

@@ -506,10 +506,8 @@ InsertionResult Map::apply(ScanUpdate& update) {
       if (!tile->reachedNone()) keys.push_back(key);
     }
   }
-  // InsertionConfig::hit_memory_scans: with Sec. V.B's clipping, the latest scans' hits clip
-  // this one's free space too.
-  const int hit_memory_scans =
-      config_.rules.clip_free_space_at_hits ? impl.insertion.hit_memory_scans : 0;
+  // InsertionConfig::hit_memory_scans: the latest scans' hits clip this one's free space too.
+  const int hit_memory_scans = impl.insertion.appliedHitMemoryScans(config_.rules);
   std::unique_ptr<detail::RecentHits>& recent_hits = storage_->recent_hits;
   if (hit_memory_scans == 0) {
     recent_hits.reset();

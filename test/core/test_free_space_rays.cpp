@@ -275,7 +275,9 @@ Scan hitsInColumn(const std::vector<int>& levels, std::size_t readings, const Ei
   scan.origin = kSensor;
   for (int level : levels) {
     for (std::size_t k = 0; k < readings; ++k) {
-      const double z = kVoxel.z() + kResolution * (level + 0.2 + 0.6 * k / readings);
+      const double z =
+          kVoxel.z() + kResolution * (level + 0.2 +
+                                      0.6 * static_cast<double>(k) / static_cast<double>(readings));
       scan.hits.push_back(Eigen::Vector3d(at.x(), at.y(), z).cast<float>());
     }
   }

@@ -425,8 +425,8 @@ int main(int argc, char** argv) {
     mvog::InsertionConfig insertion;
     insertion.evidence_limit = arguments.evidence_limit;
     report.evidence_limit = insertion.appliedEvidenceLimit(arguments.rules);
-    report.hit_memory_scans =
-        arguments.rules.clip_free_space_at_hits ? arguments.hit_memory_scans : 0;
+    insertion.hit_memory_scans = arguments.hit_memory_scans;
+    report.hit_memory_scans = insertion.appliedHitMemoryScans(arguments.rules);
     report.out_of_range = arguments.out_of_range;
     report.repeat = arguments.repeat;
     const auto start = std::chrono::steady_clock::now();
