@@ -130,10 +130,16 @@ class Reconfigure(unittest.TestCase):
     def test_3_a_new_cross_section_height_moves_its_grid(self):
         rel.wait_for(lambda: self.cross_section.grid is not None, "~cross_section_0")
         self.assertAlmostEqual(self.cross_section.grid.info.origin.position.z, 0.5)
+        projected_before = self.projected.messages
         reported = self.client.update_configuration({"cross_section_heights_text": "0.75"})
         self.assertEqual(reported["cross_section_heights_text"], "0.75")
         rel.wait_for(lambda: abs(self.cross_section.grid.info.origin.position.z - 0.75) < 1e-9,
                      "~cross_section_0 at z = 0.75")
+        # An accepted change republishes every grid, ~projected_map too, on a topic of its own
+        # that may arrive after ~cross_section_0's: awaited here, or it would land in the next
+        # test's count of grids a refused value must not republish.
+        rel.wait_for(lambda: self.projected.messages > projected_before,
+                     "~projected_map republished")
 
 
 if __name__ == "__main__":
