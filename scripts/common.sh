@@ -66,14 +66,14 @@ install_missing_packages() {
 }
 
 # The catkin workspace links the repository as its only package (catkin's default
-# CATKIN_ENABLE_TESTING=ON declares the tests; `catkin_make run_tests` builds them). Its compile
-# commands are what scripts/lint.sh gives clang-tidy. mvog_bench gets the peers' backends (Bonxai)
-# only where MVOG_PEERS_DIR is set (scripts/benchmarks.sh sets it; the tests never do).
+# CATKIN_ENABLE_TESTING=ON declares the tests; `catkin_make run_tests` builds them). mvog_bench
+# gets the peers' backends (Bonxai) only where MVOG_PEERS_DIR is set (scripts/benchmarks.sh sets
+# it; the tests never do).
 build_workspace() {
   mkdir -p "$WORKSPACE/src"
   ln -sfn "$REPO" "$WORKSPACE/src/mvog"
   (cd "$WORKSPACE" && quietly catkin_make catkin_make -DCMAKE_BUILD_TYPE=Release \
-    -DCMAKE_EXPORT_COMPILE_COMMANDS=ON "-DMVOG_PEERS_DIR=${MVOG_PEERS_DIR:-}" -j2)
+    "-DMVOG_PEERS_DIR=${MVOG_PEERS_DIR:-}" -j2)
 }
 
 source_workspace() {

@@ -124,8 +124,7 @@ count_script() {
   fi
 }
 
-# 3. The linters (catkin_lint, shellcheck, clang-tidy: scripts/lint.sh), on the compile commands of
-# the build above. Not beside the catkin tests: at normal priority, the tests' replays at 50x lost
+# 3. The linters (catkin_lint, shellcheck, clang-tidy: scripts/lint.sh). Not beside the catkin tests: at normal priority, the tests' replays at 50x lost
 # scans; at idle priority (chrt --idle), the tests slowed by as much as the linters gained (629 s
 # for both side by side with 4edce5d's test.sh, 607 s one after the other, on a 2-core machine).
 bash "$REPO/scripts/lint.sh" >"$LOG_DIR/lint.log" 2>&1 || true
