@@ -136,6 +136,18 @@ enum class FreeSpaceRays : std::uint8_t {
 /// The most scans InsertionConfig::hit_memory_scans may name: their hits are kept by column.
 constexpr int kMaxHitMemoryScans = 100;
 
+/// Which scans InsertionConfig::hit_memory_scans groups (Sec. V.B's scan groups).
+enum class HitMemoryScope : std::uint8_t {
+  /// Line scans (their readings in one plane through the origin: a 2D laser's scan, one line of
+  /// a tilting laser) remember the hits of the line scans before them; any other scan (a depth
+  /// image, a lidar's sweep, a tilting laser's whole nod) is a group of its own and forgets them.
+  kLineScans,
+  /// Every scan: a tilting laser's nods from poses across a room keep each other's hits too (its
+  /// surfaces called free fall by a third to a half), but a depth camera's noisy hits hide the
+  /// free space beside surfaces for as many frames (BENCHMARKS.md section 13).
+  kEveryScan,
+};
+
 /// How readings are turned into volumes (Sec. III-B).
 struct InsertionConfig {
   /// Obstacle readings closer than this to the sensor (m) are dropped.
@@ -165,15 +177,19 @@ struct InsertionConfig {
   double evidence_limit = kDefaultEvidenceLimit;
   /// Sec. V.B's scan groups: with ModelRules::clip_free_space_at_hits, a scan's free space in a
   /// column is clipped around the hits of the previous hit_memory_scans scans inserted into the
-  /// map as well as around its own (joined as its own are). A laser that grazes a wall in the
-  /// scans before and after the few that hit it then erases those hits less (the corridor's and
-  /// the tilting laser's surfaces called free fall by a sixth to a half, BENCHMARKS.md section
-  /// 13); a depth camera's noisy hits hide the free space beside surfaces for as many scans.
-  /// Every insertion into the map counts as a scan (an empty one, a single reading), and one
-  /// with 0 forgets the hits kept, as Map::clear does; they are held beside the map
-  /// (Map::memoryUsage). 0: a scan's own hits only (the paper's). At most kMaxHitMemoryScans.
-  /// Not saved in the map file.
-  int hit_memory_scans = 0;
+  /// map as well as around its own (joined as its own are), for the scans hit_memory_scope says.
+  /// A line scan alone samples a surface along one line: a laser that grazes a wall in the lines
+  /// before and after the few that hit it would erase those hits. A scan of a 2D sensor (a depth
+  /// image, a sweep) is already the group the paper asks for. Every insertion into the map that
+  /// inserts a reading counts as a scan (a single reading too); one with 0, one outside the
+  /// scope, and Map::clear forget the hits kept. They are held beside the map (Map::memoryUsage).
+  /// The default, 5: on the 2D laser's ground-truth scene the surfaces called free reach their
+  /// floor at 2-3 scans and its thin objects pass OctoMap's at 5, while each further scan takes
+  /// free space along the rays of the 2D laser logs (BENCHMARKS.md section 13). 0: a scan's own
+  /// hits only (the paper's). At most kMaxHitMemoryScans. Not saved in the map file.
+  int hit_memory_scans = 5;
+  /// See HitMemoryScope.
+  HitMemoryScope hit_memory_scope = HitMemoryScope::kLineScans;
 
   /// Throws ConfigError naming the first invalid field.
   void validate() const;

@@ -34,7 +34,7 @@ struct SensorInputsConfig {
 
 /// The insertion worker (InsertionWorker): the core's insertion parameters (~min_range,
 /// ~max_range, ~insert_out_of_range, ~model_negative_space, ~insertion_threads,
-/// ~free_space_rays, ~evidence_limit), and its queue.
+/// ~free_space_rays, ~evidence_limit, ~hit_memory_scans, ~hit_memory_scope), and its queue.
 /// The model's rules are the map's (MapperConfig::map: ~model, ~clip_free_space_at_hits, ...).
 struct InsertionWorkerConfig : mvog::InsertionConfig {
   int insertion_queue_size = 3;  // converted messages waiting to be inserted
@@ -50,6 +50,10 @@ struct InsertionWorkerConfig : mvog::InsertionConfig {
 /// `one_path_per_end_column` (kOnePathPerEndColumn) or `every_reading` (kEveryReading). Throws
 /// mvog::ConfigError naming the parameter for any other name.
 mvog::FreeSpaceRays freeSpaceRaysFromName(const std::string& name);
+
+/// ~hit_memory_scope: `line_scans` (HitMemoryScope::kLineScans, the default) or `every_scan`
+/// (kEveryScan). Throws mvog::ConfigError naming the parameter for any other name.
+mvog::HitMemoryScope hitMemoryScopeFromName(const std::string& name);
 
 /// Decay (Sec. III-E): masses times decay_factor every decay_period seconds.
 struct DecayConfig {

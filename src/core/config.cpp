@@ -37,6 +37,9 @@ void InsertionConfig::validate() const {
               free_space_rays == FreeSpaceRays::kOnePerEndVoxel ||
               free_space_rays == FreeSpaceRays::kOnePathPerEndColumn,
           "free_space_rays", "must be kEveryReading, kOnePerEndVoxel or kOnePathPerEndColumn");
+  require(hit_memory_scope == HitMemoryScope::kLineScans ||
+              hit_memory_scope == HitMemoryScope::kEveryScan,
+          "hit_memory_scope", "must be kLineScans or kEveryScan");
 }
 
 }  // namespace mvog

@@ -506,8 +506,15 @@ InsertionResult Map::apply(ScanUpdate& update) {
       if (!tile->reachedNone()) keys.push_back(key);
     }
   }
-  // InsertionConfig::hit_memory_scans: the latest scans' hits clip this one's free space too.
-  const int hit_memory_scans = impl.insertion.appliedHitMemoryScans(config_.rules);
+  // A scan that inserts no reading (none given, or every one rejected) changes nothing: not the
+  // map, nor the hits kept (a burst of bad messages does not empty them).
+  if (impl.result.inserted() == 0) return impl.result;
+  // InsertionConfig::hit_memory_scans: the latest scans' hits clip this one's free space too; a
+  // scan outside hit_memory_scope is a group of its own (Sec. V.B), and the hits kept are
+  // forgotten.
+  const bool in_scope =
+      impl.line_scan || impl.insertion.hit_memory_scope == HitMemoryScope::kEveryScan;
+  const int hit_memory_scans = in_scope ? impl.insertion.appliedHitMemoryScans(config_.rules) : 0;
   std::unique_ptr<detail::RecentHits>& recent_hits = storage_->recent_hits;
   if (hit_memory_scans == 0) {
     recent_hits.reset();

@@ -663,6 +663,12 @@ GroupedScan groupByEndVoxel(const DepthFrame& frame, const MapConfig& map_config
                             const InsertionConfig& insertion, ThreadPool* pool,
                             std::vector<EndVoxelRays>& voxels, InsertionResult& result);
 
+/// Whether every reading of `scan` lies in one plane through its origin, as a line scanner's do
+/// (a 2D laser's scan, one line of a tilting laser): InsertionConfig::hit_memory_scans groups
+/// such scans (Sec. V.B). Within a thousandth of a cell (`resolution`, m), and the single
+/// precision's rounding of the readings. A scan of one reading, or of readings in line, is one.
+bool isLineScan(const Scan& scan, double resolution);
+
 /// Whether a scan's free space is walked one ray per end voxel (FreeSpaceRays).
 inline bool walksOneRayPerEndVoxel(const MapConfig& map_config, const InsertionConfig& insertion) {
   return map_config.rules.mass_counting == MassCounting::kPerScan &&
@@ -718,6 +724,9 @@ struct ScanUpdate::Impl {
   /// Of the scan prepared (Map::apply bounds the columns with its evidence limit).
   InsertionConfig insertion;
   InsertionResult result;
+  /// Whether the scan prepared is a line scanner's (detail::isLineScan; a depth image's never):
+  /// the scans InsertionConfig::hit_memory_scans groups.
+  bool line_scan = false;
   /// One per chunk of readings (one per thread).
   std::vector<detail::ScanScratch> scratches;
   /// Those of threads the last scan did not use, kept with their memory.

@@ -558,6 +558,48 @@ void splitEndVoxelsBySector(const EndVoxelRays& voxels, const Eigen::Vector3d& s
   }
 }
 
+bool isLineScan(const Scan& scan, double resolution) {
+  // visit(p) for each finite reading (the others are rejected) from the origin, while it returns
+  // true; whether it did for all.
+  auto every_finite = [&](auto&& visit) {
+    for (const auto* points : {&scan.hits, &scan.out_of_range}) {
+      for (const Eigen::Vector3f& p : *points) {
+        if (p.allFinite() && !visit(Eigen::Vector3d(p.cast<double>() - scan.origin))) return false;
+      }
+    }
+    return true;
+  };
+  // A reading's distance from the plane may be a thousandth of a cell, and the float's rounding
+  // of the reading and the normal's error (some 1e-7 of its magnitude each) in room to spare.
+  const double tolerance = 1e-3 * resolution + 1e-6 * scan.origin.cwiseAbs().maxCoeff();
+  auto all_within = [&](const Eigen::Vector3d& normal) {
+    return every_finite([&](const Eigen::Vector3d& p) {
+      return std::fabs(normal.dot(p)) <= tolerance + 1e-6 * p.cwiseAbs().maxCoeff();
+    });
+  };
+  Eigen::Vector3d along = Eigen::Vector3d::Zero();
+  every_finite([&](const Eigen::Vector3d& p) {
+    if (p.squaredNorm() > 0.0) along = p.normalized();
+    return p.squaredNorm() == 0.0;
+  });
+  if (along.squaredNorm() == 0.0) return true;
+  // The plane's normal from the first reading and the first one at least ~6 degrees off its
+  // line (sin 0.1): its direction is then known to within a few roundings of a float, at any
+  // range. Where every reading is within 6 degrees of that line, the plane through the one
+  // farthest from it, which holds them all if they lie in one.
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  every_finite([&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d cross = along.cross(p);
+    if (cross.norm() >= 0.1 * p.norm()) {
+      normal = cross;
+      return false;
+    }
+    if (cross.squaredNorm() > normal.squaredNorm()) normal = cross;
+    return true;
+  });
+  return normal.squaredNorm() == 0.0 || all_within(normal.normalized());
+}
+
 }  // namespace detail
 
 detail::ThreadPool* ScanUpdate::Impl::threads(std::size_t count) {
@@ -587,6 +629,7 @@ void ScanUpdate::begin(const MapConfig& map_config, const InsertionConfig& inser
   impl.map_config = map_config;
   impl.insertion = insertion;
   impl.result = InsertionResult{};
+  impl.line_scan = false;
   const auto num_threads = static_cast<std::size_t>(insertion.insertion_threads);
   // A server switches between one thread and several as its queue backs up: the scratches of the
   // threads a scan does not use wait with their memory instead of being freed.
@@ -604,6 +647,7 @@ void ScanUpdate::begin(const MapConfig& map_config, const InsertionConfig& inser
 void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
                          const InsertionConfig& insertion) {
   begin(map_config, insertion);
+  impl_->line_scan = detail::isLineScan(scan, map_config.resolution);
   if (!detail::walksOneRayPerEndVoxel(map_config, insertion)) {
     prepareEveryReading(scan);
     return;
@@ -628,6 +672,7 @@ void ScanUpdate::prepare(const DepthFrame& frame, const MapConfig& map_config,
     const Scan scan = backProjectDepthImage(frame, skipped);
     prepare(scan, map_config, insertion);
     impl_->result.rejected_no_measurement = skipped;
+    impl_->line_scan = false;  // an image's pixels, whatever plane its readings happen to lie in
     return;
   }
   begin(map_config, insertion);

@@ -115,6 +115,11 @@ void bindConfigs(py::module_& module) {
       .value("EVERY_READING", mvog::FreeSpaceRays::kEveryReading)
       .value("ONE_PER_END_VOXEL", mvog::FreeSpaceRays::kOnePerEndVoxel)
       .value("ONE_PATH_PER_END_COLUMN", mvog::FreeSpaceRays::kOnePathPerEndColumn);
+  py::enum_<mvog::HitMemoryScope>(module, "HitMemoryScope",
+                                  "Which scans hit_memory_scans groups (Sec. V.B's scan groups).")
+      .value("LINE_SCANS", mvog::HitMemoryScope::kLineScans,
+             "scans whose readings lie in one plane through the origin (a 2D laser's)")
+      .value("EVERY_SCAN", mvog::HitMemoryScope::kEveryScan);
   py::enum_<mvog::OccupancyState>(module, "OccupancyState",
                                   "A point's or a cell's state; arrays of states hold these "
                                   "values as uint8 (0 unknown, 1 free, 2 occupied).")
@@ -187,13 +192,14 @@ void bindConfigs(py::module_& module) {
       .field("hit_memory_scans", &mvog::InsertionConfig::hit_memory_scans,
              "Scans before a scan whose hits clip its free space as its own do (Sec. V.B's scan "
              "groups, with clip_free_space_at_hits); 0 (its own only) to 100.")
+      .field("hit_memory_scope", &mvog::InsertionConfig::hit_memory_scope, "See HitMemoryScope.")
       .done()
       .def(py::init([](double min_range, double max_range, bool insert_out_of_range,
                        bool model_negative_space, int threads, mvog::FreeSpaceRays rays,
-                       double evidence_limit, int hit_memory_scans) {
+                       double evidence_limit, int hit_memory_scans, mvog::HitMemoryScope scope) {
              return validated(mvog::InsertionConfig{min_range, max_range, insert_out_of_range,
                                                     model_negative_space, threads, rays,
-                                                    evidence_limit, hit_memory_scans});
+                                                    evidence_limit, hit_memory_scans, scope});
            }),
            py::kw_only(), py::arg("min_range") = insertion.min_range,
            py::arg("max_range") = insertion.max_range,
@@ -202,7 +208,8 @@ void bindConfigs(py::module_& module) {
            py::arg("insertion_threads") = insertion.insertion_threads,
            py::arg("free_space_rays") = insertion.free_space_rays,
            py::arg("evidence_limit") = insertion.evidence_limit,
-           py::arg("hit_memory_scans") = insertion.hit_memory_scans);
+           py::arg("hit_memory_scans") = insertion.hit_memory_scans,
+           py::arg("hit_memory_scope") = insertion.hit_memory_scope);
 
   const mvog::PlanningConfig planning;
   ConfigClass<mvog::PlanningConfig>(module, "PlanningConfig",

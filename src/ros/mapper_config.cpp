@@ -188,6 +188,13 @@ mvog::FreeSpaceRays freeSpaceRaysFromName(const std::string& name) {
   return mvog::FreeSpaceRays::kOnePathPerEndColumn;
 }
 
+mvog::HitMemoryScope hitMemoryScopeFromName(const std::string& name) {
+  if (name == "line_scans") return mvog::HitMemoryScope::kLineScans;
+  require(name == "every_scan", "hit_memory_scope",
+          "must be 'line_scans' or 'every_scan', not '" + name + "'");
+  return mvog::HitMemoryScope::kEveryScan;
+}
+
 void DecayConfig::validate() const {
   require(std::isfinite(decay_factor) && decay_factor > 0.0 && decay_factor <= 1.0, "decay_factor",
           "must be in (0, 1]");
@@ -282,6 +289,9 @@ MapperConfig MapperConfig::fromParameters(const ros::NodeHandle& private_nh) {
   insertion.free_space_rays = freeSpaceRaysFromName(free_space_rays);
   read(nh, "evidence_limit", insertion.evidence_limit);
   read(nh, "hit_memory_scans", insertion.hit_memory_scans);
+  std::string hit_memory_scope = "line_scans";
+  read(nh, "hit_memory_scope", hit_memory_scope);
+  insertion.hit_memory_scope = hitMemoryScopeFromName(hit_memory_scope);
   read(nh, "insertion_queue_size", insertion.insertion_queue_size);
   read(nh, "backlog_insertion_threads", insertion.backlog_insertion_threads);
 

@@ -98,7 +98,13 @@ struct LevelCell {
   const Eigen::Vector3d origin{0.0, 0.05, 0.05};
   const Eigen::Vector3d in_cell{1.05, 0.05, 0.05};
 
-  explicit LevelCell(double evidence_limit) { insertion.evidence_limit = evidence_limit; }
+  /// Each scan a group of its own (hit_memory_scans 0): the counts below are the evidence
+  /// limit's alone; with the default a crossing clears hits only once the line scans that hit
+  /// are out of the group (Rules.HitMemory*).
+  explicit LevelCell(double evidence_limit) {
+    insertion.evidence_limit = evidence_limit;
+    insertion.hit_memory_scans = 0;
+  }
   void cross(int scans) {
     for (int k = 0; k < scans; ++k) {
       map.insertReading(origin, {2.05, 0.05, 0.05}, ReadingKind::kObstacle, insertion);

@@ -588,13 +588,15 @@ std::string describe(const ModelRules& rules) {
 
 /// Insertions walking every reading's ray, one ray per end voxel and one path per end column
 /// (FreeSpaceRays), each with unbounded evidence and with InsertionConfig::evidence_limit 3
-/// (reached within the tests' scans).
+/// (reached within the tests' scans); each scan a group of its own, as the references make them
+/// (hit_memory_scans 0: the Rules.HitMemory tests check the scan groups).
 std::vector<InsertionConfig> everyRayChoice() {
   std::vector<InsertionConfig> choices;
   for (FreeSpaceRays rays : {FreeSpaceRays::kEveryReading, FreeSpaceRays::kOnePerEndVoxel,
                              FreeSpaceRays::kOnePathPerEndColumn}) {
     for (double evidence_limit : {std::numeric_limits<double>::infinity(), 3.0}) {
       InsertionConfig insertion;
+      insertion.hit_memory_scans = 0;
       insertion.free_space_rays = rays;
       insertion.evidence_limit = evidence_limit;
       choices.push_back(insertion);
@@ -1060,15 +1062,19 @@ TEST(Rules, ClippingKeepsFreeSpaceBesideAHitAndDropsASliver) {
 
 TEST(Rules, ClippingIsWithinOneScan) {
   // A later scan's free space clears an earlier scan's hit as in the paper (what lets a person
-  // who walked away be forgotten): the hit's column gets free space at its height.
+  // who walked away be forgotten): the hit's column gets free space at its height. Each scan a
+  // group of its own (hit_memory_scans 0; with the default the line scans of a group keep it:
+  // HitMemoryForgetsAfterItsScans...).
   Map map(unitConfig(10000.0, ModelRules{}));
+  InsertionConfig own_hits_only;
+  own_hits_only.hit_memory_scans = 0;
   Scan first;
   first.origin = {0.5, 0.5, 0.5};
   first.hits.push_back({3.5f, 0.5f, 0.5f});
-  map.insertScan(first);
+  map.insertScan(first, own_hits_only);
   Scan second = first;
   second.hits = {{6.5f, 0.5f, 0.5f}};
-  map.insertScan(second);
+  map.insertScan(second, own_hits_only);
   const PointOccupancy at_hit = map.occupancy({3.5, 0.5, 0.5});
   ASSERT_TRUE(at_hit.known());
   EXPECT_FLOAT_EQ(*at_hit.probability, 0.5f);  // one hit, one pass: each counted once
@@ -1122,8 +1128,8 @@ TEST(Rules, HitMemoryKeepsTheFreeSpaceAboveAndBelowARememberedHit) {
 }
 
 TEST(Rules, HitMemoryForgetsAfterItsScansAfterAnInsertionWithoutItAndAfterClear) {
-  // With 2 the hit clips the next two scans' free space, not the third's; an insertion with 0,
-  // or Map::clear, forgets the hits kept.
+  // With 2 the hit clips the next two scans' free space, not the third's; an insertion with 0, a
+  // scan that is not a line, or Map::clear, forgets the hits kept.
   auto passes_until_freed = [](auto between) {
     Map map(unitConfig(10000.0, ModelRules{}));
     InsertionConfig insertion;
@@ -1139,10 +1145,43 @@ TEST(Rules, HitMemoryForgetsAfterItsScansAfterAnInsertionWithoutItAndAfterClear)
   };
   EXPECT_EQ(passes_until_freed([](Map&) {}), 3);
   EXPECT_EQ(passes_until_freed([](Map& map) {
-              InsertionConfig without;  // hit_memory_scans 0
+              InsertionConfig without;
+              without.hit_memory_scans = 0;
               map.insertScan(Scan{{0.5, 0.5, 0.5}, {{0.5f, 5.5f, 0.5f}}, {}}, without);
             }),
             1);
+  // A scan that is not a line (its readings in no one plane through its origin: a camera's, a
+  // sweep's) is a group of its own: it forgets the line scans' hits.
+  EXPECT_EQ(
+      passes_until_freed([](Map& map) {
+        InsertionConfig with_memory;
+        with_memory.hit_memory_scans = 2;
+        map.insertScan(
+            Scan{{0.5, 0.5, 0.5}, {{0.5f, 5.5f, 0.5f}, {0.5f, 5.5f, 3.5f}, {4.5f, 4.5f, 0.5f}}, {}},
+            with_memory);
+      }),
+      1);
+  // A rejected reading (here the first) does not make a line of the others.
+  EXPECT_EQ(
+      passes_until_freed([](Map& map) {
+        InsertionConfig with_memory;
+        with_memory.hit_memory_scans = 2;
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        map.insertScan(
+            Scan{{0.5, 0.5, 0.5},
+                 {{nan, 0.5f, 0.5f}, {0.5f, 5.5f, 0.5f}, {0.5f, 5.5f, 3.5f}, {4.5f, 4.5f, 0.5f}},
+                 {}},
+            with_memory);
+      }),
+      1);
+  // An insertion that inserts no reading (every one rejected) is no scan: the hits stay kept.
+  EXPECT_EQ(passes_until_freed([](Map& map) {
+              InsertionConfig without;
+              without.hit_memory_scans = 0;
+              const float nan = std::numeric_limits<float>::quiet_NaN();
+              map.insertScan(Scan{{0.5, 0.5, 0.5}, {{nan, 0.5f, 0.5f}}, {}}, without);
+            }),
+            3);
   EXPECT_EQ(passes_until_freed([](Map& map) { map.clear(); }), 1);
 }
 
@@ -1159,12 +1198,35 @@ TEST(Rules, HitMemoryNeedsClippingAtHits) {
   EXPECT_FLOAT_EQ(*map.occupancy({3.5, 0.5, 0.5}).probability, 0.5f);
 }
 
+/// A tilting laser's lines from (0.3, 0.2, 1.1): `lines` scans of 361 readings at random ranges,
+/// each in the plane through the origin that holds the y axis and is tilted by a further 0.02 rad
+/// about it, line by line.
+std::vector<Scan> tiltingLaserLines(unsigned seed, int lines) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> range(1.0, 9.0);
+  std::vector<Scan> scans;
+  for (int line = 0; line < lines; ++line) {
+    Scan scan;
+    scan.origin = {0.3, 0.2, 1.1};
+    const double tilt = -0.3 + 0.02 * line;
+    const Eigen::Vector3d ahead(std::cos(tilt), 0.0, std::sin(tilt));
+    for (int k = 0; k <= 360; ++k) {
+      const double azimuth = (k - 180) * M_PI / 360.0;
+      const Eigen::Vector3d direction =
+          std::cos(azimuth) * ahead + std::sin(azimuth) * Eigen::Vector3d::UnitY();
+      scan.hits.push_back((scan.origin + range(rng) * direction).cast<float>());
+    }
+    scans.push_back(scan);
+  }
+  return scans;
+}
+
 TEST(Rules, HitMemoryBuildsTheSameMapWithAnyThreads) {
   // The recent hits are read by every thread's tiles and recorded after the scan: 1 to 3
-  // threads build the same map, which the memory changes.
+  // threads build the same map of a tilting laser's lines, which the memory changes.
   MapConfig map_config;
   map_config.resolution = 0.25;
-  const std::vector<Scan> scans = testScans(7);
+  const std::vector<Scan> scans = tiltingLaserLines(7, 12);
   std::vector<std::vector<test::VolumeRecord>> maps;
   for (int threads = 1; threads <= 3; ++threads) {
     Map map(map_config);
@@ -1177,9 +1239,34 @@ TEST(Rules, HitMemoryBuildsTheSameMapWithAnyThreads) {
   for (int threads = 2; threads <= 3; ++threads) {
     EXPECT_TRUE(test::sameVolumes(maps[threads - 1], maps[0])) << threads << " threads";
   }
+  InsertionConfig without_memory;
+  without_memory.hit_memory_scans = 0;
   Map without(map_config);
-  for (const Scan& scan : scans) without.insertScan(scan);
+  for (const Scan& scan : scans) without.insertScan(scan, without_memory);
   EXPECT_FALSE(test::sameVolumes(allVolumes(without), maps[0]));
+  // The lines are line scans; the same readings a hair off their plane are not, and each is then
+  // a group of its own, as without the memory.
+  InsertionConfig with_memory;
+  with_memory.hit_memory_scans = 2;
+  Map off_plane(map_config);
+  for (Scan scan : scans) {
+    scan.hits[90].z() += 0.01f;  // 1 cm: 0.04 cells, beyond a thousandth of one
+    off_plane.insertScan(scan, with_memory);
+  }
+  Map off_plane_without(map_config);
+  for (Scan scan : scans) {
+    scan.hits[90].z() += 0.01f;
+    off_plane_without.insertScan(scan, without_memory);
+  }
+  EXPECT_TRUE(test::sameVolumes(allVolumes(off_plane), allVolumes(off_plane_without)));
+  // HitMemoryScope::kEveryScan groups them all the same.
+  with_memory.hit_memory_scope = HitMemoryScope::kEveryScan;
+  Map every_scan(map_config);
+  for (Scan scan : scans) {
+    scan.hits[90].z() += 0.01f;
+    every_scan.insertScan(scan, with_memory);
+  }
+  EXPECT_FALSE(test::sameVolumes(allVolumes(every_scan), allVolumes(off_plane_without)));
 }
 
 TEST(Rules, PerScanAHeightCountsOncePerScan) {

@@ -589,6 +589,8 @@ TEST(Config, InsertionConfigFieldsAreChecked) {
       {with([](InsertionConfig& c) { c.hit_memory_scans = -1; }), "hit_memory_scans"},
       {with([](InsertionConfig& c) { c.hit_memory_scans = kMaxHitMemoryScans + 1; }),
        "hit_memory_scans"},
+      {with([](InsertionConfig& c) { c.hit_memory_scope = static_cast<HitMemoryScope>(2); }),
+       "hit_memory_scope"},
       {with([](InsertionConfig& c) { c.insertion_threads = 0; }), "insertion_threads"},
       {with([](InsertionConfig& c) { c.insertion_threads = -2; }), "insertion_threads"},
       {with([](InsertionConfig& c) { c.insertion_threads = 257; }), "insertion_threads"}};

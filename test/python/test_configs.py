@@ -23,7 +23,8 @@ def test_defaults_are_the_cpp_defaults():
     assert insertion.insertion_threads == 1
     assert insertion.free_space_rays == mvog.FreeSpaceRays.ONE_PER_END_VOXEL
     assert insertion.evidence_limit == 14.0
-    assert insertion.hit_memory_scans == 0
+    assert insertion.hit_memory_scans == 5
+    assert insertion.hit_memory_scope == mvog.HitMemoryScope.LINE_SCANS
     planning = mvog.PlanningConfig()
     assert planning.occupancy_threshold == mvog.DEFAULT_OCCUPANCY_THRESHOLD == 0.324
     assert planning.max_query_cells == 50000000

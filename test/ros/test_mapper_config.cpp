@@ -33,6 +33,22 @@ std::string refusal(const MapperConfig& config) {
   return "";
 }
 
+/// Expects `read(name)` to refuse each of `names`, naming ~`parameter`.
+template <class Read>
+void expectNamesRefused(Read read, const std::string& parameter,
+                        std::initializer_list<const char*> names) {
+  for (const char* name : names) {
+    std::string message;
+    try {
+      read(name);
+    } catch (const mvog::ConfigError& e) {
+      message = e.what();
+    }
+    EXPECT_EQ(message.rfind("~" + parameter + ":", 0), 0u)
+        << "'" << name << "': got '" << message << "'";
+  }
+}
+
 struct InvalidCase {
   std::string parameter;  // the parameter the message must name (without ~)
   std::string what;
@@ -313,17 +329,9 @@ TEST(MapperConfig, FreeSpaceRaysDefaultsToOnePerEndVoxelAndReadsTheThreeNames) {
 
 TEST(MapperConfig, RefusesAnUnknownFreeSpaceRaysNamingIt) {
   // mvog_bench's spelling, another case, empty: only the three names are read.
-  for (const char* name :
-       {"every-reading", "one-path-per-end-column", "Every_Reading", "one_per_voxel", ""}) {
-    std::string message;
-    try {
-      freeSpaceRaysFromName(name);
-    } catch (const mvog::ConfigError& e) {
-      message = e.what();
-    }
-    EXPECT_EQ(message.rfind("~free_space_rays:", 0), 0u)
-        << "'" << name << "': got '" << message << "'";
-  }
+  expectNamesRefused(
+      freeSpaceRaysFromName, "free_space_rays",
+      {"every-reading", "one-path-per-end-column", "Every_Reading", "one_per_voxel", ""});
   expectRefused({"free_space_rays", "not a FreeSpaceRays", [](MapperConfig& c) {
                    c.insertion.free_space_rays = static_cast<mvog::FreeSpaceRays>(7);
                  }});
@@ -340,15 +348,27 @@ TEST(MapperConfig, EvidenceLimitDefaultsToTheCoresAndRefusesLessThanOneNamingIt)
   }
 }
 
-TEST(MapperConfig, HitMemoryDefaultsToNoneAndRefusesOutOfRangeNamingIt) {
-  EXPECT_EQ(validConfig().insertion.hit_memory_scans, 0);
-  MapperConfig laser = validConfig();
-  laser.insertion.hit_memory_scans = 3;
-  EXPECT_EQ(refusal(laser), "");
+TEST(MapperConfig, HitMemoryDefaultsToFiveLineScansAndRefusesOutOfRangeNamingIt) {
+  EXPECT_EQ(validConfig().insertion.hit_memory_scans, 5);
+  EXPECT_EQ(validConfig().insertion.hit_memory_scope, mvog::HitMemoryScope::kLineScans);
+  MapperConfig own_hits_only = validConfig();
+  own_hits_only.insertion.hit_memory_scans = 0;
+  EXPECT_EQ(refusal(own_hits_only), "");
   for (int scans : {-1, mvog::kMaxHitMemoryScans + 1}) {
     expectRefused({"hit_memory_scans", std::to_string(scans),
                    [scans](MapperConfig& c) { c.insertion.hit_memory_scans = scans; }});
   }
+}
+
+TEST(MapperConfig, HitMemoryScopeReadsItsTwoNamesAndRefusesAnyOtherNamingIt) {
+  EXPECT_EQ(hitMemoryScopeFromName("line_scans"), mvog::HitMemoryScope::kLineScans);
+  EXPECT_EQ(hitMemoryScopeFromName("every_scan"), mvog::HitMemoryScope::kEveryScan);
+  // mvog_bench's spelling, another case, empty.
+  expectNamesRefused(hitMemoryScopeFromName, "hit_memory_scope",
+                     {"line-scans", "Every_Scan", "lines", ""});
+  expectRefused({"hit_memory_scope", "not a HitMemoryScope", [](MapperConfig& c) {
+                   c.insertion.hit_memory_scope = static_cast<mvog::HitMemoryScope>(7);
+                 }});
 }
 
 TEST(MapperConfig, AnEmptyAutosaveFileIsFineWhileAutosaveIsOff) {

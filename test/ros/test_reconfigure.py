@@ -2,7 +2,7 @@
 """dynamic_reconfigure on a running mapping server (see reconfigure.test and README).
 
 One mvog_node named mvog_mapper, as mapper.launch names it. A laser beam hits a cell once and
-then crosses it once (its p between 0 and 1). `rosrun dynamic_reconfigure dynparam set` puts the
+then crosses it once (its p between 0 and 1; each scan a group of its own). `rosrun dynamic_reconfigure dynparam set` puts the
 occupancy threshold below that p, the Python client above it: ~projected_map and ~get_occupancy
 follow each time. Bad values (a threshold of 1.5, forgetting without decay, cross-section heights
 that are not numbers or not as many as at start) are refused: the reported configuration and the
@@ -37,8 +37,10 @@ class Reconfigure(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.broadcaster = rel.init_test_node("test_reconfigure")
+        # Each scan a group of its own (~hit_memory_scans 0): the second beam's crossing counts
+        # against the first's hit, which the default's scan groups of line scans would keep.
         cls.server = rel.Server(NAME, {"publish_period": 0.2, "cross_section_heights": [0.5],
-                                       "decay_factor": 1.0}).wait_ready()
+                                       "decay_factor": 1.0, "hit_memory_scans": 0}).wait_ready()
         cls.server.scans.publish(beam(2.0))
         cls.server.wait_counter("messages_inserted", 1)
         cls.server.scans.publish(beam(3.0))  # crosses the cell it hit

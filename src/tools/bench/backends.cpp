@@ -54,6 +54,7 @@ MvogRun runMvog(const InputData& input, const RunOptions& options) {
   insertion.free_space_rays = options.free_space_rays;
   insertion.evidence_limit = options.evidence_limit;
   insertion.hit_memory_scans = options.hit_memory_scans;
+  insertion.hit_memory_scope = options.hit_memory_scope;
   MvogRun run{mvog::Map(map_config), {}};
   MvogStats& stats = run.stats;
   stats.threads = options.threads;

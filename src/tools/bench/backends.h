@@ -38,6 +38,8 @@ struct RunOptions {
   double evidence_limit = mvog::InsertionConfig{}.evidence_limit;
   /// MVOG only: InsertionConfig::hit_memory_scans.
   int hit_memory_scans = mvog::InsertionConfig{}.hit_memory_scans;
+  /// MVOG only: InsertionConfig::hit_memory_scope.
+  mvog::HitMemoryScope hit_memory_scope = mvog::InsertionConfig{}.hit_memory_scope;
 };
 
 /// Seconds from `start` to now (steady clock): what each backend's insertion took.

@@ -7,6 +7,7 @@
 //              [--mass-counting per-scan|per-reading] [--split-free-space-at-obstacles on|off]
 //              [--free-space-rays one-path-per-end-column|one-per-end-voxel|every-reading]
 //              [--octomap-clamping on|off] [--evidence-limit E|inf] [--hit-memory-scans S]
+//              [--hit-memory-scope line-scans|every-scan]
 //              [--truth-slice OUT.ppm]
 // Everything is read first; only the insertion is timed. See BENCHMARKS.md.
 #include <algorithm>
@@ -44,6 +45,7 @@ struct Arguments {
   bool octomap_clamping = true;
   double evidence_limit = mvog::InsertionConfig{}.evidence_limit;
   int hit_memory_scans = mvog::InsertionConfig{}.hit_memory_scans;
+  mvog::HitMemoryScope hit_memory_scope = mvog::InsertionConfig{}.hit_memory_scope;
   bool run_mvog = false;
   bool run_octomap = false;
   bool run_bonxai = false;
@@ -71,7 +73,7 @@ constexpr const char* kUsage =
     "                  [--free-space-rays one-path-per-end-column|one-per-end-voxel|\n"
     "                                     every-reading]\n"
     "                  [--octomap-clamping on|off] [--evidence-limit E|inf]\n"
-    "                  [--hit-memory-scans S]\n"
+    "                  [--hit-memory-scans S] [--hit-memory-scope line-scans|every-scan]\n"
     "                  [--truth-slice OUT.ppm]\n"
     "  FILE        a ROS bag (LaserScan, PointCloud2 and/or depth Image 16UC1 or 32FC1 with\n"
     "              CameraInfo; poses from /tf and /tf_static)\n"
@@ -105,7 +107,9 @@ constexpr const char* kUsage =
     "              (mvog::InsertionConfig::evidence_limit; default 14)\n"
     "  S           MVOG clips a scan's free space around the hits of the S scans before it\n"
     "              too, with clip_free_space_at_hits (Sec. V.B's scan groups;\n"
-    "              mvog::InsertionConfig::hit_memory_scans; default 0: its own only)\n"
+    "              mvog::InsertionConfig::hit_memory_scans; default 5; 0: its own only)\n"
+    "  --hit-memory-scope  the scans S groups: line scans (the default: their readings in\n"
+    "              one plane through the origin) or every scan (mvog::HitMemoryScope)\n"
     "  --octomap-clamping  OctoMap's log-odds clamped at each update (on, its default) or\n"
     "              not (off: every hit and miss counts, as MVOG's masses do)\n"
     "  --truth-slice  with truth:NAME, a cross-section of the scene with each map's errors\n"
@@ -212,6 +216,15 @@ Arguments parseArguments(int argc, char** argv) {
           value == "inf" ? std::numeric_limits<double>::infinity() : positiveNumber(option, value);
     } else if (option == "--hit-memory-scans") {
       arguments.hit_memory_scans = wholeNumber(option, value, 0, mvog::kMaxHitMemoryScans);
+    } else if (option == "--hit-memory-scope") {
+      if (value == "line-scans") {
+        arguments.hit_memory_scope = mvog::HitMemoryScope::kLineScans;
+      } else if (value == "every-scan") {
+        arguments.hit_memory_scope = mvog::HitMemoryScope::kEveryScan;
+      } else {
+        throw UsageError("--hit-memory-scope must be line-scans or every-scan, got '" + value +
+                         "'");
+      }
     } else if (option == "--octomap-clamping") {
       arguments.octomap_clamping = onOff(option, value);
     } else if (option == "--json") {
@@ -272,6 +285,7 @@ mvog_bench::ResolutionReport benchmarkResolution(const Arguments& arguments,
   options.octomap_clamping = arguments.octomap_clamping;
   options.evidence_limit = arguments.evidence_limit;
   options.hit_memory_scans = arguments.hit_memory_scans;
+  options.hit_memory_scope = arguments.hit_memory_scope;
   mvog_bench::ResolutionReport report;
   report.resolution = resolution;
   report.voxel_grid_cells = mvog_bench::boundingBoxVoxels(input, options);
@@ -427,6 +441,7 @@ int main(int argc, char** argv) {
     report.evidence_limit = insertion.appliedEvidenceLimit(arguments.rules);
     insertion.hit_memory_scans = arguments.hit_memory_scans;
     report.hit_memory_scans = insertion.appliedHitMemoryScans(arguments.rules);
+    report.hit_memory_scope = arguments.hit_memory_scope;
     report.out_of_range = arguments.out_of_range;
     report.repeat = arguments.repeat;
     const auto start = std::chrono::steady_clock::now();

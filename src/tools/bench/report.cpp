@@ -206,6 +206,10 @@ std::string rulesText(const mvog::ModelRules& rules) {
               : std::to_string(rules.out_of_range_free_length).substr(0, 5) + " m");
 }
 
+const char* hitMemoryScopeText(mvog::HitMemoryScope scope) {
+  return scope == mvog::HitMemoryScope::kLineScans ? "line scans" : "every scan";
+}
+
 /// A map's scores at the labelled points: shares of the points in the state each label calls
 /// right (and the two errors a planner pays for), and the F1 of "occupied".
 JsonObject truthJson(double resolution, const TruthResult& result) {
@@ -258,10 +262,11 @@ void printReport(const BenchReport& report, const InputData& input, std::FILE* o
   }
   std::fprintf(out,
                "MVOG rules  %s%s; occupied where p > %.3f; evidence limit %g; hit memory %d "
-               "scans\n",
+               "scans (%s)\n",
                rulesText(report.rules).c_str(),
                report.rules == mvog::ModelRules::paper() ? " (the paper's model)" : "",
-               report.occupancy_threshold, report.evidence_limit, report.hit_memory_scans);
+               report.occupancy_threshold, report.evidence_limit, report.hit_memory_scans,
+               hitMemoryScopeText(report.hit_memory_scope));
   std::fprintf(out, "OctoMap     log-odds clamping %s\n\n",
                report.octomap_clamping ? "on (its default)" : "off");
 
@@ -544,6 +549,7 @@ void writeJson(const BenchReport& report, const InputData& input, const std::str
       .add("octomap_clamping", report.octomap_clamping)
       .add("evidence_limit", report.evidence_limit)
       .add("hit_memory_scans", report.hit_memory_scans)
+      .add("hit_memory_scope", std::string(hitMemoryScopeText(report.hit_memory_scope)))
       .add("repeat", report.repeat)
       .add("table_one", table_one)
       .add("quality", quality)

@@ -48,8 +48,10 @@ struct BenchReport {
   bool octomap_clamping = true;  ///< RunOptions::octomap_clamping
   double evidence_limit = 0.0;   ///< RunOptions::evidence_limit, as applied (infinity: none)
   int hit_memory_scans = 0;      ///< RunOptions::hit_memory_scans, as applied
-  bool out_of_range = false;     ///< the out-of-range readings were given to MVOG
-  int repeat = 1;                ///< insertions per backend; the fastest is reported
+  /// RunOptions::hit_memory_scope.
+  mvog::HitMemoryScope hit_memory_scope = mvog::HitMemoryScope::kLineScans;
+  bool out_of_range = false;  ///< the out-of-range readings were given to MVOG
+  int repeat = 1;             ///< insertions per backend; the fastest is reported
   std::vector<ResolutionReport> resolutions;
 };
 
