@@ -358,12 +358,11 @@ void boundStoredColumn(const detail::ColumnRef& column, double max_density,
   Volume* stored = const_cast<Volume*>(existing.positive);
   scanColumn(local, hits, detail::joinGapOf(rules), work);
   const std::vector<ScanInterval>* clip_at = &work.positive;
-  if (work.tile_remembered) {
+  if (work.column_remembered) {
     // Sec. V.B's scan groups: the latest scans' hits clip the free space as the scan's own do,
     // joined as a scan's own are (whichever scan saw them).
     work.clip_at.assign(work.positive.begin(), work.positive.end());
-    work.recent_hits->append(detail::cellKey(detail::cellInTile(origin, local)),
-                             work.hit_memory_scans, work.clip_at);
+    work.recent_hits->append(*work.remembered_tile, local, work.hit_memory_scans, work.clip_at);
     std::sort(work.clip_at.begin(), work.clip_at.end(),
               [](const ScanInterval& a, const ScanInterval& b) { return a.bottom < b.bottom; });
     detail::joinSorted(work.clip_at, detail::joinGapOf(rules));
@@ -427,20 +426,21 @@ MVOG_ALSO_FOR_POPCNT void updateTile(detail::TileBlock& tile, std::uint64_t key,
   const bool per_scan = rules.mass_counting == MassCounting::kPerScan;
   HitCursor hit_cursor(work.hits);
   // With one thread's part, a cell's free space may be one interval read from it directly;
-  // not in a tile where InsertionConfig::hit_memory_scans's recent hits may clip it
+  // not in a column where InsertionConfig::hit_memory_scans's recent hits may clip it
   // (updateColumn).
-  work.tile_remembered =
-      work.recent_hits != nullptr && work.recent_hits->holdsTile(key, work.hit_memory_scans);
-  const auto* only_part =
-      work.parts.size() == 1 && !work.tile_remembered ? &work.parts[0] : nullptr;
+  work.remembered_tile =
+      work.recent_hits != nullptr ? work.recent_hits->tile(key, work.hit_memory_scans) : nullptr;
+  const auto* only_part = work.parts.size() == 1 ? &work.parts[0] : nullptr;
   const detail::TileBlock::Layout layout(tile);
   for (std::size_t word = 0; word < std::size(work.reached); ++word) {
     for (std::uint64_t bits = work.reached[word]; bits != 0; bits &= bits - 1) {
       const auto local = static_cast<unsigned>(64 * word + detail::lowestBit(bits));
       const HitRun hits = hit_cursor.next(local);
       const detail::ColumnRef existing = layout.column(local);
+      work.column_remembered =
+          work.remembered_tile != nullptr && work.remembered_tile->mayHold(local);
       ScanInterval single;
-      if (hits.empty() && only_part != nullptr &&
+      if (hits.empty() && only_part != nullptr && !work.column_remembered &&
           only_part->first->singleFree(*only_part->second, local, single)) {
         // The commonest cases without a vector in between: one free interval, no hit, changed
         // in the tile's own storage, or a cell's first volume.

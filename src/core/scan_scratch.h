@@ -690,15 +690,18 @@ inline float joinGapOf(const ModelRules& rules) {
 }
 
 class RecentHits;
+struct RecentTileHits;
 
 /// One thread's working memory while Map::apply applies a scan (ScanUpdate::Impl keeps it from
 /// scan to scan).
 struct alignas(kCacheLine) ColumnWork {
   /// The map's recent hits that clip the scan's free space (InsertionConfig::hit_memory_scans),
-  /// or null, those of how many scans, and whether the tile being updated holds some.
+  /// or null, those of how many scans, those of the tile being updated (RecentHits::tile, or
+  /// null), and whether the column being updated may hold some.
   const RecentHits* recent_hits = nullptr;
   int hit_memory_scans = 0;
-  bool tile_remembered = false;
+  const RecentTileHits* remembered_tile = nullptr;
+  bool column_remembered = false;
   ListMerger merger;
   /// The scratches that reached the tile being updated, and their part of it.
   std::vector<std::pair<const ScanScratch*, const ScratchTile*>> parts;
