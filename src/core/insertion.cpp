@@ -512,9 +512,8 @@ InsertionResult Map::apply(ScanUpdate& update) {
   // InsertionConfig::hit_memory_scans: the latest scans' hits clip this one's free space too; a
   // scan outside hit_memory_scope is a group of its own (Sec. V.B), and the hits kept are
   // forgotten.
-  const bool in_scope =
-      impl.line_scan || impl.insertion.hit_memory_scope == HitMemoryScope::kEveryScan;
-  const int hit_memory_scans = in_scope ? impl.insertion.appliedHitMemoryScans(config_.rules) : 0;
+  const int hit_memory_scans =
+      impl.joins_hit_memory ? impl.insertion.appliedHitMemoryScans(config_.rules) : 0;
   std::unique_ptr<detail::RecentHits>& recent_hits = storage_->recent_hits;
   if (hit_memory_scans == 0) {
     recent_hits.reset();

@@ -669,6 +669,12 @@ GroupedScan groupByEndVoxel(const DepthFrame& frame, const MapConfig& map_config
 /// precision's rounding of the readings. A scan of one reading, or of readings in line, is one.
 bool isLineScan(const Scan& scan, double resolution);
 
+/// Whether a scan joins the map's scan groups (InsertionConfig::hit_memory_scope): every scan
+/// does with HitMemoryScope::kEveryScan; with kLineScans a line scan (isLineScan) does, tested
+/// only where the map remembers hits at all. `scan` is null for a depth image, never a line.
+bool joinsHitMemory(const MapConfig& map_config, const InsertionConfig& insertion,
+                    const Scan* scan);
+
 /// Whether a scan's free space is walked one ray per end voxel (FreeSpaceRays).
 inline bool walksOneRayPerEndVoxel(const MapConfig& map_config, const InsertionConfig& insertion) {
   return map_config.rules.mass_counting == MassCounting::kPerScan &&
@@ -727,9 +733,9 @@ struct ScanUpdate::Impl {
   /// Of the scan prepared (Map::apply bounds the columns with its evidence limit).
   InsertionConfig insertion;
   InsertionResult result;
-  /// Whether the scan prepared is a line scanner's (detail::isLineScan; a depth image's never):
-  /// the scans InsertionConfig::hit_memory_scans groups.
-  bool line_scan = false;
+  /// Whether the scan prepared joins the map's scan groups (detail::joinsHitMemory): Map::apply
+  /// clips it around the hits kept and keeps its own, or else forgets them.
+  bool joins_hit_memory = false;
   /// One per chunk of readings (one per thread).
   std::vector<detail::ScanScratch> scratches;
   /// Those of threads the last scan did not use, kept with their memory.

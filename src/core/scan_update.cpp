@@ -600,6 +600,13 @@ bool isLineScan(const Scan& scan, double resolution) {
   return normal.squaredNorm() == 0.0 || all_within(normal.normalized());
 }
 
+bool joinsHitMemory(const MapConfig& map_config, const InsertionConfig& insertion,
+                    const Scan* scan) {
+  if (insertion.hit_memory_scope == HitMemoryScope::kEveryScan) return true;
+  return scan != nullptr && insertion.appliedHitMemoryScans(map_config.rules) > 0 &&
+         isLineScan(*scan, map_config.resolution);
+}
+
 }  // namespace detail
 
 detail::ThreadPool* ScanUpdate::Impl::threads(std::size_t count) {
@@ -629,7 +636,8 @@ void ScanUpdate::begin(const MapConfig& map_config, const InsertionConfig& inser
   impl.map_config = map_config;
   impl.insertion = insertion;
   impl.result = InsertionResult{};
-  impl.line_scan = false;
+  // As a depth image's (prepare(const Scan&) tests whether a scan is a line).
+  impl.joins_hit_memory = detail::joinsHitMemory(map_config, insertion, nullptr);
   const auto num_threads = static_cast<std::size_t>(insertion.insertion_threads);
   // A server switches between one thread and several as its queue backs up: the scratches of the
   // threads a scan does not use wait with their memory instead of being freed.
@@ -647,7 +655,7 @@ void ScanUpdate::begin(const MapConfig& map_config, const InsertionConfig& inser
 void ScanUpdate::prepare(const Scan& scan, const MapConfig& map_config,
                          const InsertionConfig& insertion) {
   begin(map_config, insertion);
-  impl_->line_scan = detail::isLineScan(scan, map_config.resolution);
+  impl_->joins_hit_memory = detail::joinsHitMemory(map_config, insertion, &scan);
   if (!detail::walksOneRayPerEndVoxel(map_config, insertion)) {
     prepareEveryReading(scan);
     return;
@@ -672,7 +680,8 @@ void ScanUpdate::prepare(const DepthFrame& frame, const MapConfig& map_config,
     const Scan scan = backProjectDepthImage(frame, skipped);
     prepare(scan, map_config, insertion);
     impl_->result.rejected_no_measurement = skipped;
-    impl_->line_scan = false;  // an image's pixels, whatever plane its readings happen to lie in
+    // An image's pixels, whatever plane its readings happen to lie in.
+    impl_->joins_hit_memory = detail::joinsHitMemory(map_config, insertion, nullptr);
     return;
   }
   begin(map_config, insertion);
